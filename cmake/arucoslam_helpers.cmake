@@ -1,0 +1,37 @@
+# arucoslam_layer(NAME PUBLIC_LINKS <libs> PRIVATE_LINKS <libs>)
+# Adds one library per layer folder from the folder's *.cc files (tests excluded)
+# and one ctest per *_test.cc, named <layer>/<file>.
+function(arucoslam_layer name)
+  cmake_parse_arguments(ARG "" "" "PUBLIC_LINKS;PRIVATE_LINKS;TEST_LINKS" ${ARGN})
+  file(GLOB sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cc)
+  file(GLOB tests CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*_test.cc)
+  if(tests)
+    list(REMOVE_ITEM sources ${tests})
+  endif()
+  set(target arucoslam_${name})
+  if(sources)
+    add_library(${target} STATIC ${sources})
+    target_include_directories(${target} PUBLIC ${PROJECT_SOURCE_DIR}/src)
+    target_compile_options(${target} PRIVATE -Wall -Wextra -Wno-unused-parameter)
+    target_link_libraries(${target} PUBLIC ${ARG_PUBLIC_LINKS} PRIVATE ${ARG_PRIVATE_LINKS})
+  else()
+    # A layer with no sources yet is header-only.
+    add_library(${target} INTERFACE)
+    target_include_directories(${target} INTERFACE ${PROJECT_SOURCE_DIR}/src)
+    target_link_libraries(${target} INTERFACE ${ARG_PUBLIC_LINKS})
+  endif()
+  if(ARUCOSLAM_BUILD_TESTS)
+    foreach(test_source ${tests})
+      get_filename_component(test_name ${test_source} NAME_WE)
+      set(test_target test_${name}_${test_name})
+      add_executable(${test_target} ${test_source})
+      target_link_libraries(${test_target} PRIVATE ${target} ${ARG_TEST_LINKS}
+                            GTest::gtest GTest::gtest_main)
+      target_compile_definitions(${test_target} PRIVATE
+        ARUCOSLAM_TEST_DATA_DIR="${ARUCOSLAM_TEST_DATA_DIR}"
+        ARUCOSLAM_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+      add_test(NAME ${name}/${test_name} COMMAND ${test_target}
+               WORKING_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR})
+    endforeach()
+  endif()
+endfunction()

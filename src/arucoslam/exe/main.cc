@@ -1,0 +1,42 @@
+// The `arucoslam` binary: parses the command line, dispatches to a subcommand, and turns
+// bad input into one clear line on stderr with exit status 2.
+#include <cstdio>
+#include <exception>
+#include <string>
+
+#include "arucoslam/exe/command.h"
+#include "arucoslam/util/error.h"
+#include "arucoslam/util/logging.h"
+
+int main(int argc, char** argv) {
+  using namespace arucoslam;
+  CLI::App app{"ArucoSLAM: monocular visual SLAM fused with ArUco fiducial markers"};
+  app.set_version_flag("--version", std::string("arucoslam ") + ARUCOSLAM_VERSION);
+  app.require_subcommand(1);
+  std::string log_level = "info";
+  app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off")
+      ->capture_default_str();
+  app.parse_complete_callback([&log_level] {
+    if (!SetLogLevel(log_level)) {
+      throw CLI::ValidationError("--log-level", "unknown level '" + log_level + "'");
+    }
+  });
+
+  int exit_status = kExitOk;
+  // Subcommands (one file each, *_command.cc).
+  (void)exit_status;
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    const int status = app.exit(error);
+    return status == 0 ? 0 : kExitBadInput;
+  } catch (const InputError& error) {
+    std::fprintf(stderr, "arucoslam: %s\n", error.what());
+    return kExitBadInput;
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "arucoslam: internal error: %s\n", error.what());
+    return kExitFailure;
+  }
+  return exit_status;
+}
