@@ -17,4 +17,25 @@ inline constexpr int kExitBadInput = 2;   // bad user input: one clear line on s
 // Appends the ids of a list such as "0-9,12,20-22"; throws InputError("--ids", ...).
 void ParseIdRangeInto(const std::string& text, std::vector<int>& ids);
 
+// `markers generate | sdf | import` (markers_command.cc).
+void AddMarkersCommand(CLI::App& app, int& exit_status);
+
+// `world factory` (world_command.cc).
+void AddWorldCommand(CLI::App& app, int& exit_status);
+
+// `eval` (eval_command.cc).
+void AddEvalCommand(CLI::App& app, int& exit_status);
+
+// `simulate` (simulate_command.cc).
+void AddSimulateCommand(CLI::App& app, int& exit_status);
+
+// `locate` (locate_command.cc).
+void AddLocateCommand(CLI::App& app, int& exit_status);
+
+// `run` (run_command.cc).
+void AddRunCommand(CLI::App& app, int& exit_status);
+
+// `vocab train | info` (vocab_command.cc).
+void AddVocabCommand(CLI::App& app, int& exit_status);
+
 }  // namespace arucoslam

@@ -24,6 +24,13 @@ int main(int argc, char** argv) {
 
   int exit_status = kExitOk;
   // Subcommands (one file each, *_command.cc).
+  AddMarkersCommand(app, exit_status);
+  AddWorldCommand(app, exit_status);
+  AddEvalCommand(app, exit_status);
+  AddSimulateCommand(app, exit_status);
+  AddLocateCommand(app, exit_status);
+  AddRunCommand(app, exit_status);
+  AddVocabCommand(app, exit_status);
   (void)exit_status;
 
   try {

@@ -26,7 +26,8 @@ struct CameraModel {
 
   // Point in the camera frame (z forward) -> pixel. nullopt when z <= 0.
   std::optional<Eigen::Vector2d> Project(const Eigen::Vector3d& p_in_cam) const;
-  // Pixel -> normalised image coordinates (x/z, y/z) with distortion removed (iterative).
+  // Pixel -> normalised image coordinates (x/z, y/z) with distortion removed (Newton).
+  // Fisheye pixels whose ray is 90 degrees or more off axis are clamped just short of 90.
   Eigen::Vector2d Unproject(const Eigen::Vector2d& pixel) const;
   // Normalised undistorted coordinates -> pixel.
   Eigen::Vector2d Distort(const Eigen::Vector2d& normalised) const;

@@ -5,6 +5,31 @@
 namespace arucoslam {
 namespace {
 constexpr double kSmallAngle = 1e-8;
+// Below this angle the SE(3) Jacobian coefficients use their Taylor series: the closed
+// forms cancel catastrophically there (the truncation error is below 1e-17).
+constexpr double kSeriesAngle = 1e-2;
+
+// (1 - cos theta) / theta^2, written with the half angle so it keeps full precision.
+double OneMinusCosOverTheta2(double theta) {
+  if (theta < kSmallAngle) return 0.5;
+  const double sinc_half = std::sin(0.5 * theta) / (0.5 * theta);
+  return 0.5 * sinc_half * sinc_half;
+}
+
+// (theta - sin theta) / theta^3.
+double ThetaMinusSinOverTheta3(double theta) {
+  const double theta2 = theta * theta;
+  if (theta < kSeriesAngle) return 1.0 / 6.0 - theta2 / 120.0 + theta2 * theta2 / 5040.0;
+  return (theta - std::sin(theta)) / (theta2 * theta);
+}
+
+// (1 - (theta / 2) cot(theta / 2)) / theta^2, the coefficient of the inverse left Jacobian.
+double InverseLeftJacobianCoefficient(double theta) {
+  const double theta2 = theta * theta;
+  if (theta < kSeriesAngle) return 1.0 / 12.0 + theta2 / 720.0 + theta2 * theta2 / 30240.0;
+  const double half = 0.5 * theta;
+  return (1.0 - half * std::cos(half) / std::sin(half)) / theta2;
+}
 }  // namespace
 
 Eigen::Matrix3d Hat(const Eigen::Vector3d& v) {
@@ -62,14 +87,9 @@ Rigid3 Rigid3::Exp(const Vector6d& tangent) {
   const Eigen::Vector3d omega = tangent.tail<3>();
   const double theta = omega.norm();
   const Eigen::Matrix3d omega_hat = Hat(omega);
-  Eigen::Matrix3d left_jacobian;
-  if (theta < kSmallAngle) {
-    left_jacobian = Eigen::Matrix3d::Identity() + 0.5 * omega_hat;
-  } else {
-    const double theta2 = theta * theta;
-    left_jacobian = Eigen::Matrix3d::Identity() + (1.0 - std::cos(theta)) / theta2 * omega_hat +
-                    (theta - std::sin(theta)) / (theta2 * theta) * omega_hat * omega_hat;
-  }
+  const Eigen::Matrix3d left_jacobian = Eigen::Matrix3d::Identity() +
+                                        OneMinusCosOverTheta2(theta) * omega_hat +
+                                        ThetaMinusSinOverTheta3(theta) * omega_hat * omega_hat;
   return Rigid3(ExpSO3(omega), left_jacobian * upsilon);
 }
 
@@ -77,15 +97,9 @@ Vector6d Rigid3::Log() const {
   const Eigen::Vector3d omega = LogSO3(rotation);
   const double theta = omega.norm();
   const Eigen::Matrix3d omega_hat = Hat(omega);
-  Eigen::Matrix3d inverse_left_jacobian;
-  if (theta < kSmallAngle) {
-    inverse_left_jacobian = Eigen::Matrix3d::Identity() - 0.5 * omega_hat;
-  } else {
-    const double half = 0.5 * theta;
-    const double coefficient = (1.0 - half * std::cos(half) / std::sin(half)) / (theta * theta);
-    inverse_left_jacobian =
-        Eigen::Matrix3d::Identity() - 0.5 * omega_hat + coefficient * omega_hat * omega_hat;
-  }
+  const Eigen::Matrix3d inverse_left_jacobian =
+      Eigen::Matrix3d::Identity() - 0.5 * omega_hat +
+      InverseLeftJacobianCoefficient(theta) * omega_hat * omega_hat;
   Vector6d tangent;
   tangent.head<3>() = inverse_left_jacobian * translation;
   tangent.tail<3>() = omega;
@@ -102,8 +116,7 @@ Eigen::Matrix<double, 6, 6> Rigid3::Adjoint() const {
 }
 
 Rigid3 Interpolate(const Rigid3& a, const Rigid3& b, double t) {
-  return Rigid3(a.rotation.slerp(t, b.rotation),
-                (1.0 - t) * a.translation + t * b.translation);
+  return Rigid3(a.rotation.slerp(t, b.rotation), (1.0 - t) * a.translation + t * b.translation);
 }
 
 }  // namespace arucoslam

@@ -6,42 +6,50 @@ namespace arucoslam {
 namespace {
 
 constexpr double kEpsilon = 1e-8;
+// Where both |sigma| and theta are below this, W's coefficients come from their Taylor
+// series (the closed forms cancel catastrophically near the origin).
+constexpr double kSeriesRadius = 1e-2;
+constexpr int kSeriesTerms = 9;  // powers of sigma; |sigma|^9 / 9! < 1e-23
 
-// The matrix W with t = W * upsilon in exp(upsilon, omega, sigma) (Strasdat's thesis, A.5).
+// The matrix W with t = W * upsilon in exp(upsilon, omega, sigma):
+//   W = integral_0^1 e^(sigma s) exp(s omega^) ds = c I + a omega^ + b omega^2, with
+//   c = int e^(sigma s), a = int e^(sigma s) sin(theta s) / theta,
+//   b = int e^(sigma s) (1 - cos(theta s)) / theta^2 (Strasdat's thesis, A.5).
 Eigen::Matrix3d SimilarityV(const Eigen::Vector3d& omega, double sigma) {
   const double theta = omega.norm();
+  const double theta2 = theta * theta;
   const Eigen::Matrix3d omega_hat = Hat(omega);
-  const Eigen::Matrix3d omega_hat2 = omega_hat * omega_hat;
-  const double scale = std::exp(sigma);
-  double a, b, c;
-  if (std::abs(sigma) < kEpsilon) {
-    c = 1.0;
-    if (theta < kEpsilon) {
-      a = 0.5;
-      b = 1.0 / 6.0;
-    } else {
-      const double theta2 = theta * theta;
-      a = (1.0 - std::cos(theta)) / theta2;
-      b = (theta - std::sin(theta)) / (theta2 * theta);
+  double a = 0.0, b = 0.0, c = 0.0;
+  if (std::abs(sigma) < kSeriesRadius && theta < kSeriesRadius) {
+    // Expand e^(sigma s) = sum sigma^n s^n / n! and the trigonometric factors to theta^4.
+    const double theta4 = theta2 * theta2;
+    double sigma_power_over_factorial = 1.0;  // sigma^n / n!
+    for (int n = 0; n < kSeriesTerms; ++n) {
+      const double k = n;
+      c += sigma_power_over_factorial / (k + 1.0);
+      a += sigma_power_over_factorial *
+           (1.0 / (k + 2.0) - theta2 / (6.0 * (k + 4.0)) + theta4 / (120.0 * (k + 6.0)));
+      b += sigma_power_over_factorial *
+           (1.0 / (2.0 * (k + 3.0)) - theta2 / (24.0 * (k + 5.0)) + theta4 / (720.0 * (k + 7.0)));
+      sigma_power_over_factorial *= sigma / (k + 1.0);
     }
   } else {
-    c = (scale - 1.0) / sigma;
+    const double scale = std::exp(sigma);
+    c = std::abs(sigma) < kEpsilon ? 1.0 + 0.5 * sigma : std::expm1(sigma) / sigma;
     if (theta < kEpsilon) {
+      // theta -> 0 limits; here |sigma| >= kSeriesRadius.
       const double sigma2 = sigma * sigma;
       a = ((sigma - 1.0) * scale + 1.0) / sigma2;
-      b = (scale * 0.5 * sigma2 + scale - 1.0 - sigma * scale) / (sigma2 * sigma);
+      b = (scale * (0.5 * sigma2 - sigma + 1.0) - 1.0) / (sigma2 * sigma);
     } else {
-      const double theta2 = theta * theta;
       const double sin_theta = std::sin(theta);
       const double cos_theta = std::cos(theta);
       const double denominator = sigma * sigma + theta2;
-      a = (scale * sin_theta * sigma + (1.0 - scale * cos_theta) * theta) /
-          (theta * denominator);
-      b = (c - ((scale * cos_theta - 1.0) * sigma + scale * sin_theta * theta) / denominator) /
-          theta2;
+      a = (scale * (sigma * sin_theta - theta * cos_theta) + theta) / (theta * denominator);
+      b = (c - (scale * (sigma * cos_theta + theta * sin_theta) - sigma) / denominator) / theta2;
     }
   }
-  return c * Eigen::Matrix3d::Identity() + a * omega_hat + b * omega_hat2;
+  return c * Eigen::Matrix3d::Identity() + a * omega_hat + b * omega_hat * omega_hat;
 }
 
 }  // namespace

@@ -37,6 +37,8 @@ std::optional<Sim3> UmeyamaAlignment(const std::vector<Eigen::Vector3d>& source,
   double scale = 1.0;
   if (kind == AlignmentKind::kSimilarity) {
     scale = (svd.singularValues().asDiagonal() * sign).trace() / source_variance;
+    // A target collapsed to one point gives scale 0: no similarity maps onto it.
+    if (!(scale > 0.0)) return std::nullopt;
   }
   const Eigen::Vector3d translation = target_mean - scale * rotation * source_mean;
   return Sim3(scale, Eigen::Quaterniond(rotation), translation);

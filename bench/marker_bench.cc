@@ -1,0 +1,98 @@
+// Marker pipeline speed: detection per 640x480 and 1280x720 frame (rendered markers over a
+// textured background), IPPE pose per marker, and the camera locator per frame.
+#include <benchmark/benchmark.h>
+
+#include <vector>
+
+#include "arucoslam/markers/camera_locator.h"
+#include "arucoslam/markers/detector.h"
+#include "arucoslam/markers/marker_pose.h"
+#include "arucoslam/markers/preprocess.h"
+#include "arucoslam/markers/synthetic_view.h"
+
+namespace arucoslam {
+namespace {
+
+CameraModel Camera(int width, int height) {
+  CameraModel camera;
+  camera.width = width;
+  camera.height = height;
+  camera.fx = camera.fy = 500.0 * width / 640.0;
+  camera.cx = 0.5 * (width - 1);
+  camera.cy = 0.5 * (height - 1);
+  return camera;
+}
+
+// Four 0.2 m markers 1.5-3 m away, tilted, spread over the image.
+std::vector<SyntheticMarker> Markers() {
+  std::vector<SyntheticMarker> markers;
+  const Eigen::Matrix3d facing =
+      Eigen::AngleAxisd(0.4, Eigen::Vector3d(0.6, 0.8, 0)) * Eigen::Vector3d(1, -1, -1).asDiagonal();
+  const Eigen::Vector3d positions[4] = {{-0.6, -0.3, 2.0}, {0.5, -0.3, 1.5}, {0.5, 0.4, 3.0},
+                                        {-0.5, 0.4, 2.5}};
+  for (int i = 0; i < 4; ++i) {
+    SyntheticMarker marker;
+    marker.id = 2 * i + 1;
+    marker.cam_from_marker = Rigid3(facing, positions[i]);
+    markers.push_back(marker);
+  }
+  return markers;
+}
+
+void BM_Detect(benchmark::State& state) {
+  const CameraModel camera = Camera(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  const cv::Mat image = RenderSyntheticView(camera, Markers(), {});
+  const MarkerDetector detector;
+  size_t found = 0;
+  for (auto _ : state) {
+    const std::vector<MarkerDetection> detections = detector.Detect(image);
+    found = detections.size();
+    benchmark::DoNotOptimize(detections.data());
+  }
+  state.counters["markers"] = static_cast<double>(found);
+}
+BENCHMARK(BM_Detect)->Args({640, 480})->Args({1280, 720})->Unit(benchmark::kMillisecond);
+
+void BM_PreprocessClahe(benchmark::State& state) {
+  const CameraModel camera = Camera(640, 480);
+  const cv::Mat image = RenderSyntheticView(camera, Markers(), {});
+  PreprocessOptions options;
+  options.clahe = true;
+  for (auto _ : state) benchmark::DoNotOptimize(Preprocess(image, options).data);
+}
+BENCHMARK(BM_PreprocessClahe)->Unit(benchmark::kMillisecond);
+
+void BM_MarkerPose(benchmark::State& state) {
+  const CameraModel camera = Camera(640, 480);
+  const std::vector<SyntheticMarker> markers = Markers();
+  MarkerDetection detection;
+  detection.id = markers[0].id;
+  detection.corners = ProjectMarkerCorners(camera, markers[0]);
+  for (auto _ : state) benchmark::DoNotOptimize(EstimateMarkerPose(detection, 0.2, camera));
+}
+BENCHMARK(BM_MarkerPose)->Unit(benchmark::kMicrosecond);
+
+void BM_LocateCamera(benchmark::State& state) {
+  const CameraModel camera = Camera(640, 480);
+  const std::vector<SyntheticMarker> markers = Markers();
+  MarkerMap map;
+  std::vector<MarkerDetection> detections;
+  for (int i = 0; i < state.range(0); ++i) {
+    MarkerInfo info;
+    info.id = markers[i].id;
+    info.size = 0.2;
+    info.world_from_marker = markers[i].cam_from_marker;  // world = camera frame
+    map.markers[info.id] = info;
+    MarkerDetection detection;
+    detection.id = info.id;
+    detection.corners = ProjectMarkerCorners(camera, markers[i]);
+    detections.push_back(detection);
+  }
+  for (auto _ : state) benchmark::DoNotOptimize(LocateCamera(detections, map, camera).found);
+}
+BENCHMARK(BM_LocateCamera)->Arg(1)->Arg(4)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+}  // namespace arucoslam
+
+BENCHMARK_MAIN();

@@ -1,0 +1,109 @@
+// Rendering throughput of the simulator at 640x480 on the default factory world along its
+// default route: render only, render + PNG encoding, and the whole dataset writer.
+#include <benchmark/benchmark.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include <filesystem>
+#include <memory>
+#include <unistd.h>
+
+#include "arucoslam/sim/dataset_writer.h"
+#include "arucoslam/sim/factory_world.h"
+#include "arucoslam/sim/path.h"
+#include "arucoslam/sim/renderer.h"
+#include "arucoslam/sim/world_model.h"
+
+namespace arucoslam {
+namespace {
+
+namespace fs = std::filesystem;
+
+CameraModel BenchCamera() {
+  CameraModel camera;
+  camera.width = 640;
+  camera.height = 480;
+  camera.fx = camera.fy = 460.0;
+  camera.cx = 319.5;
+  camera.cy = 239.5;
+  camera.rate_hz = 30.0;
+  return camera;
+}
+
+// The default factory written once to a temporary folder, with its repeat-run poses.
+struct BenchWorld {
+  fs::path dir;
+  WorldModel world;
+  std::vector<TimedPose> poses;
+
+  BenchWorld() {
+    dir = fs::temp_directory_path() / ("arucoslam_render_bench_" + std::to_string(getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const FactoryWorld factory = BuildFactoryWorld(FactoryOptions{});
+    WriteFactoryWorld(factory, dir);
+    world = LoadWorldModel(dir / "world.sdf");
+    poses = GenerateCameraPath(factory.default_route, PathRun::kRepeat);
+  }
+  ~BenchWorld() { fs::remove_all(dir); }
+};
+
+BenchWorld& World() {
+  static BenchWorld world;
+  return world;
+}
+
+// state.range(0): MSAA samples.
+void BM_RenderFrame(benchmark::State& state) {
+  BenchWorld& bench = World();
+  RenderOptions options;
+  options.msaa_samples = static_cast<int>(state.range(0));
+  options.noise_sigma = 2.0;
+  Renderer renderer(bench.world, BenchCamera(), options);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const RenderedFrame frame = renderer.Render(bench.poses[i % bench.poses.size()].world_from_cam, i);
+    benchmark::DoNotOptimize(frame.grey.data);
+    i += 7;
+  }
+  state.counters["frames/s"] = benchmark::Counter(state.iterations(), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_RenderFrame)->Arg(1)->Arg(2)->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_RenderAndEncodePng(benchmark::State& state) {
+  BenchWorld& bench = World();
+  RenderOptions options;
+  options.noise_sigma = 2.0;
+  Renderer renderer(bench.world, BenchCamera(), options);
+  std::size_t i = 0;
+  std::vector<uchar> png;
+  for (auto _ : state) {
+    const RenderedFrame frame = renderer.Render(bench.poses[i % bench.poses.size()].world_from_cam, i);
+    cv::imencode(".png", frame.grey, png, {cv::IMWRITE_PNG_COMPRESSION, 1});
+    benchmark::DoNotOptimize(png.data());
+    i += 7;
+  }
+  state.counters["frames/s"] = benchmark::Counter(state.iterations(), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_RenderAndEncodePng)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The whole writer (rendering overlapped with PNG writing) on the first 3 s of the route.
+void BM_WriteSequence(benchmark::State& state) {
+  BenchWorld& bench = World();
+  std::vector<TimedPose> poses(bench.poses.begin(),
+                               bench.poses.begin() + std::min<std::size_t>(90, bench.poses.size()));
+  DatasetWriterOptions options;
+  options.render.noise_sigma = 2.0;
+  options.progress = false;
+  for (auto _ : state) {
+    WriteSimulatedSequence(bench.dir / "world.sdf", BenchCamera(), poses, bench.dir / "seq",
+                           options);
+  }
+  state.counters["frames/s"] = benchmark::Counter(
+      static_cast<double>(state.iterations() * poses.size()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_WriteSequence)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+
+}  // namespace
+}  // namespace arucoslam
+
+BENCHMARK_MAIN();

@@ -1,0 +1,148 @@
+// Runs the `arucoslam eval` binary: evo's numbers on its test data, the files it writes,
+// and one clear line with exit status 2 for each kind of bad input.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+
+#include "arucoslam/util/files.h"
+
+namespace arucoslam {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kEvoData = fs::path(ARUCOSLAM_TEST_DATA_DIR) / "evo_testdata";
+
+struct RunResult {
+  int status = -1;
+  std::string out;
+  std::string err;
+};
+
+class EvalCommandTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    folder_ = fs::temp_directory_path() /
+              ("eval_command_test_" + std::to_string(getpid()) + "_" +
+               ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(folder_);
+    fs::create_directories(folder_);
+  }
+  void TearDown() override { fs::remove_all(folder_); }
+
+  RunResult Run(const std::string& arguments) const {
+    const fs::path out = folder_ / "stdout.txt";
+    const fs::path err = folder_ / "stderr.txt";
+    const std::string command = std::string(ARUCOSLAM_BINARY) + " eval " + arguments + " > " +
+                                out.string() + " 2> " + err.string();
+    const int raw = std::system(command.c_str());
+    RunResult result;
+    result.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    result.out = ReadTextFile(out);
+    result.err = ReadTextFile(err);
+    return result;
+  }
+
+  // A small TUM ground truth: 50 poses at 10 Hz from t = 100 s.
+  fs::path WriteGroundTruth() const {
+    std::string text = "# t tx ty tz qx qy qz qw\n";
+    for (int i = 0; i < 50; ++i) {
+      text += std::to_string(100.0 + 0.1 * i) + " " + std::to_string(0.1 * i) + " 0 0 0 0 0 1\n";
+    }
+    const fs::path path = folder_ / "gt.txt";
+    WriteTextFileAtomically(path, text);
+    return path;
+  }
+
+  fs::path Write(const std::string& name, const std::string& text) const {
+    WriteTextFileAtomically(folder_ / name, text);
+    return folder_ / name;
+  }
+
+  fs::path folder_;
+};
+
+TEST_F(EvalCommandTest, ReproducesEvoAndWritesResultsAndPlots) {
+  if (!fs::is_directory(kEvoData)) GTEST_SKIP() << "missing test data folder " << kEvoData;
+  const fs::path out = folder_ / "out";
+  const RunResult run =
+      Run("--gt " + (kEvoData / "fr2_desk_groundtruth.txt").string() + " --est " +
+          (kEvoData / "fr2_desk_ORB_kf_mono.txt").string() + " --est " +
+          (kEvoData / "fr2_desk_ORB.txt").string() + " --label mono --label full --align sim3" +
+          " --rpe 1frames --rpe 0.5m --at 10 --out " + out.string());
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_NE(run.out.find("mono"), std::string::npos);
+  EXPECT_NE(run.out.find("APE translation rmse [m]"), std::string::npos);
+  const nlohmann::json json = nlohmann::json::parse(ReadTextFile(out / "results.json"));
+  ASSERT_EQ(json["estimates"].size(), 2u);
+  // evo v1.36.5: fr2_desk_ORB_kf_mono, APE Sim3, 118 pairs, rmse 0.007729 (README of the data).
+  const nlohmann::json& mono = json["estimates"][0];
+  EXPECT_EQ(mono["poses"]["pairs"], 118);
+  EXPECT_NEAR(mono["ape"]["translation_m"]["rmse"].get<double>(), 0.007729, 5e-7);
+  EXPECT_NEAR(mono["rpe"][0]["translation_m"]["rmse"].get<double>(), 0.007069, 5e-7);
+  EXPECT_EQ(mono["rpe"][0]["translation_m"]["count"], 117);
+  EXPECT_EQ(json["estimates"][1]["poses"]["pairs"], 2174);
+  for (const char* name : {"trajectory_top_down.svg", "ape_over_time.svg", "per_axis_error.svg",
+                           "table.txt"}) {
+    EXPECT_TRUE(fs::is_regular_file(out / name)) << name;
+  }
+  EXPECT_NE(ReadTextFile(out / "trajectory_top_down.svg").find(">full</text>"),
+            std::string::npos);
+}
+
+TEST_F(EvalCommandTest, StatsFileIsReported) {
+  const fs::path gt = WriteGroundTruth();
+  const fs::path stats =
+      Write("stats.json", R"({"tracking": {"losses": 2, "relocalisations": 1}})");
+  const RunResult run = Run("--gt " + gt.string() + " --est " + gt.string() + " --stats " +
+                            stats.string() + " --out " + (folder_ / "o").string());
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_NE(run.out.find("2 / 1"), std::string::npos);
+  const nlohmann::json json = nlohmann::json::parse(ReadTextFile(folder_ / "o" / "results.json"));
+  EXPECT_EQ(json["estimates"][0]["tracking"]["relocalisations"], 1);
+  EXPECT_EQ(json["estimates"][0]["ape"]["translation_m"]["rmse"].get<double>(), 0.0);
+}
+
+TEST_F(EvalCommandTest, BadInputIsOneLineAndStatusTwo) {
+  const fs::path gt = WriteGroundTruth();
+  const fs::path out = folder_ / "not_written";
+  struct Case {
+    std::string est_text;
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+      {"100.0 0 0 0 0 0 0 1\n100.1 0 0 0 0 0 1\n", "line 2: expected 8 numbers"},
+      {"100.0 0 0 0 0 0 0 1\n100.1 0 nan 0 0 0 0 1\n", "line 2: value 'nan' is not finite"},
+      {"900 0 0 0 0 0 0 1\n901 0 0 0 0 0 0 1\n902 0 0 0 0 0 0 1\n",
+       "no pose within 0.01 s of a ground-truth pose"},
+      {"100.0 0 0 0 0 0 0 1\n100.1 0.1 0 0 0 0 0 1\n", "only 2 pose(s) associated"},
+  };
+  for (const Case& c : cases) {
+    const fs::path est = Write("est.txt", c.est_text);
+    const RunResult run =
+        Run("--gt " + gt.string() + " --est " + est.string() + " --out " + out.string());
+    EXPECT_EQ(run.status, 2) << c.expected;
+    EXPECT_NE(run.err.find("arucoslam: " + est.string() + ": "), std::string::npos) << run.err;
+    EXPECT_NE(run.err.find(c.expected), std::string::npos) << run.err;
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+    EXPECT_FALSE(fs::exists(out)) << "nothing is written on bad input";
+  }
+  const RunResult bad_align =
+      Run("--gt " + gt.string() + " --est " + gt.string() + " --align affine");
+  EXPECT_EQ(bad_align.status, 2);
+  EXPECT_NE(bad_align.err.find("--align: expected none, se3 or sim3"), std::string::npos);
+  const RunResult bad_rpe = Run("--gt " + gt.string() + " --est " + gt.string() + " --rpe 3x");
+  EXPECT_EQ(bad_rpe.status, 2);
+  EXPECT_NE(bad_rpe.err.find("--rpe: cannot read '3x'"), std::string::npos);
+  const RunResult missing = Run("--gt " + (folder_ / "nope.txt").string() + " --est " +
+                                gt.string());
+  EXPECT_EQ(missing.status, 2);
+  EXPECT_NE(missing.err.find("nope.txt"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace arucoslam

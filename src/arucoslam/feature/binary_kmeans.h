@@ -1,0 +1,56 @@
+// K-majority clustering of 256-bit binary descriptors (k-means with Hamming distance and the
+// bitwise majority as centroid, k-means++ seeding): the building step of the Vocabulary tree.
+#pragma once
+
+#include <array>
+#include <bit>
+#include <cstdint>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "arucoslam/feature/keypoints.h"
+
+namespace arucoslam {
+
+using BinaryDescriptor = std::array<std::uint8_t, kOrbDescriptorBytes>;
+
+// Bits that differ between two 32-byte descriptors (0..256).
+inline int DescriptorDistance(const std::uint8_t* a, const std::uint8_t* b) {
+  int bits = 0;
+  for (int k = 0; k < kOrbDescriptorBytes; k += 8) {
+    std::uint64_t wa;
+    std::uint64_t wb;
+    std::memcpy(&wa, a + k, 8);
+    std::memcpy(&wb, b + k, 8);
+    bits += std::popcount(wa ^ wb);
+  }
+  return bits;
+}
+
+// Bitwise majority of the selected descriptors: bit j is set when more than half of them
+// have it set (a tie gives 0). Minimises the summed Hamming distance to them. All zeros for
+// an empty selection.
+BinaryDescriptor MajorityDescriptor(const std::vector<BinaryDescriptor>& descriptors,
+                                    const std::vector<std::uint32_t>& selection);
+
+struct KMajorityOptions {
+  int k = 10;               // clusters wanted (fewer when there are fewer distinct descriptors)
+  int max_iterations = 10;  // assignment/update rounds after seeding; stops earlier when stable
+  bool Check() const { return k >= 2 && max_iterations >= 1; }
+};
+
+struct KMajorityResult {
+  std::vector<BinaryDescriptor> centers;         // no empty cluster
+  std::vector<std::vector<std::uint32_t>> members;  // members[c]: entries of `selection`
+};
+
+// Clusters descriptors[selection[i]]. Seeding picks the first centre uniformly and each
+// further one with probability proportional to the squared distance to the nearest chosen
+// centre; `rng` makes it reproducible. With at most k distinct descriptors each distinct
+// one becomes a cluster.
+KMajorityResult KMajority(const std::vector<BinaryDescriptor>& descriptors,
+                          const std::vector<std::uint32_t>& selection,
+                          const KMajorityOptions& options, std::mt19937_64& rng);
+
+}  // namespace arucoslam

@@ -1,0 +1,91 @@
+#include "arucoslam/feature/place_database.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace arucoslam {
+
+bool PlaceQueryOptions::Check() const {
+  return max_results >= 1 && min_score >= 0.0 && min_score <= 1.0 && min_shared_words >= 1;
+}
+
+PlaceDatabase::PlaceDatabase(std::size_t num_words) : inverted_(num_words) {}
+
+void PlaceDatabase::Add(std::uint64_t entry, const BowVector& bow, FeatureVector direct) {
+  Erase(entry);
+  for (const BowVector::Entry& word : bow.entries) {
+    if (word.word >= inverted_.size()) inverted_.resize(word.word + 1);
+    inverted_[word.word].push_back({entry, word.weight});
+  }
+  entries_[entry] = Stored{bow, std::move(direct)};
+}
+
+bool PlaceDatabase::Erase(std::uint64_t entry) {
+  const auto it = entries_.find(entry);
+  if (it == entries_.end()) return false;
+  for (const BowVector::Entry& word : it->second.bow.entries) {
+    std::vector<Posting>& postings = inverted_[word.word];
+    std::erase_if(postings, [entry](const Posting& p) { return p.entry == entry; });
+  }
+  entries_.erase(it);
+  return true;
+}
+
+void PlaceDatabase::Clear() {
+  for (std::vector<Posting>& postings : inverted_) postings.clear();
+  entries_.clear();
+}
+
+std::vector<PlaceMatch> PlaceDatabase::Query(const BowVector& bow,
+                                             const PlaceQueryOptions& options,
+                                             const std::function<bool(std::uint64_t)>& keep) const {
+  if (!options.Check()) throw std::invalid_argument("PlaceDatabase::Query: bad options");
+  // Accumulates, per entry, sum over shared words of |q| + |e| - |q - e| (= 2 min(q, e) for
+  // non-negative weights): twice the L1 score.
+  std::unordered_map<std::uint64_t, PlaceMatch> accumulated;
+  for (const BowVector::Entry& word : bow.entries) {
+    if (word.word >= inverted_.size()) continue;
+    for (const Posting& posting : inverted_[word.word]) {
+      PlaceMatch& match = accumulated[posting.entry];
+      match.entry = posting.entry;
+      match.score += std::abs(word.weight) + std::abs(posting.weight) -
+                     std::abs(word.weight - posting.weight);
+      ++match.num_shared_words;
+    }
+  }
+  std::vector<PlaceMatch> matches;
+  matches.reserve(accumulated.size());
+  for (auto& [entry, match] : accumulated) {
+    match.score = std::clamp(0.5 * match.score, 0.0, 1.0);
+    if (match.score < options.min_score || match.num_shared_words < options.min_shared_words) {
+      continue;
+    }
+    if (keep && !keep(entry)) continue;
+    matches.push_back(match);
+  }
+  const auto better = [](const PlaceMatch& a, const PlaceMatch& b) {
+    return a.score != b.score ? a.score > b.score : a.entry < b.entry;
+  };
+  const std::size_t count = std::min<std::size_t>(options.max_results, matches.size());
+  std::partial_sort(matches.begin(), matches.begin() + count, matches.end(), better);
+  matches.resize(count);
+  return matches;
+}
+
+const BowVector* PlaceDatabase::Bow(std::uint64_t entry) const {
+  const auto it = entries_.find(entry);
+  return it == entries_.end() ? nullptr : &it->second.bow;
+}
+
+const FeatureVector* PlaceDatabase::Direct(std::uint64_t entry) const {
+  const auto it = entries_.find(entry);
+  return it == entries_.end() ? nullptr : &it->second.direct;
+}
+
+const std::vector<PlaceDatabase::Posting>& PlaceDatabase::Postings(WordId word) const {
+  static const std::vector<Posting> kNone;
+  return word < inverted_.size() ? inverted_[word] : kNone;
+}
+
+}  // namespace arucoslam

@@ -1,0 +1,192 @@
+#include "arucoslam/geometry/camera.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace arucoslam {
+namespace {
+
+// Iteration limits of the inverse distortion (Newton, quadratic convergence): the error
+// left after a step of size s is about s^2, so stopping once s < 1e-10 leaves ~1e-20.
+constexpr int kMaxUndistortIterations = 20;
+constexpr double kUndistortTolerance = 1e-10;  // step size (normalised units or radians)
+
+// Below this radius (normalised units) the fisheye maps use their Taylor limits.
+constexpr double kSmallRadius = 1e-8;
+// Unprojection clamps the fisheye incidence angle just short of 90 degrees, where the
+// normalised coordinates (tan theta) diverge.
+constexpr double kMaxFisheyeTheta = 0.5 * std::numbers::pi - 1e-6;
+
+using Matrix2d = Eigen::Matrix2d;
+
+// Radial-tangential distortion (OpenCV) of normalised coordinates and its 2x2 Jacobian.
+Eigen::Vector2d DistortRadTan(const std::array<double, 5>& d, const Eigen::Vector2d& p,
+                              Matrix2d* jacobian) {
+  const double k1 = d[0], k2 = d[1], p1 = d[2], p2 = d[3], k3 = d[4];
+  const double x = p.x(), y = p.y();
+  const double r2 = x * x + y * y;
+  const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  const Eigen::Vector2d distorted(x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x),
+                                  y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y);
+  if (jacobian != nullptr) {
+    const double radial_d_r2 = k1 + r2 * (2.0 * k2 + 3.0 * k3 * r2);
+    (*jacobian)(0, 0) = radial + 2.0 * x * x * radial_d_r2 + 2.0 * p1 * y + 6.0 * p2 * x;
+    (*jacobian)(0, 1) = 2.0 * x * y * radial_d_r2 + 2.0 * p1 * x + 2.0 * p2 * y;
+    (*jacobian)(1, 0) = 2.0 * x * y * radial_d_r2 + 2.0 * p1 * x + 2.0 * p2 * y;
+    (*jacobian)(1, 1) = radial + 2.0 * y * y * radial_d_r2 + 6.0 * p1 * y + 2.0 * p2 * x;
+  }
+  return distorted;
+}
+
+// theta_d(theta) = theta (1 + k1 theta^2 + k2 theta^4 + k3 theta^6 + k4 theta^8) and its
+// derivative, the equidistant (Kannala-Brandt) polynomial of OpenCV's fisheye module.
+double FisheyeThetaD(const std::array<double, 5>& d, double theta, double* derivative) {
+  const double t2 = theta * theta;
+  const double poly = 1.0 + t2 * (d[0] + t2 * (d[1] + t2 * (d[2] + t2 * d[3])));
+  if (derivative != nullptr) {
+    *derivative = 1.0 + t2 * (3.0 * d[0] + t2 * (5.0 * d[1] + t2 * (7.0 * d[2] + 9.0 * t2 * d[3])));
+  }
+  return theta * poly;
+}
+
+// Equidistant distortion of normalised coordinates: p * theta_d / r, and its Jacobian.
+Eigen::Vector2d DistortEquidistant(const std::array<double, 5>& d, const Eigen::Vector2d& p,
+                                   Matrix2d* jacobian) {
+  const double r = p.norm();
+  if (r < kSmallRadius) {
+    // scale(r) = 1 + (k1 - 1/3) r^2 + O(r^4): the Jacobian is the identity to O(r^2).
+    if (jacobian != nullptr) jacobian->setIdentity();
+    return p;
+  }
+  const double theta = std::atan(r);
+  double theta_d_d_theta = 0.0;
+  const double theta_d = FisheyeThetaD(d, theta, &theta_d_d_theta);
+  const double scale = theta_d / r;
+  if (jacobian != nullptr) {
+    // d scale / d r = (theta_d'(theta) / (1 + r^2) - scale) / r; d r / d p = p^T / r.
+    const double scale_d_r = (theta_d_d_theta / (1.0 + r * r) - scale) / r;
+    *jacobian = scale * Matrix2d::Identity() + (scale_d_r / r) * p * p.transpose();
+  }
+  return scale * p;
+}
+
+}  // namespace
+
+bool CameraModel::Check() const {
+  if (width <= 0 || height <= 0) return false;
+  if (!(fx > 0.0) || !(fy > 0.0) || !std::isfinite(fx) || !std::isfinite(fy)) return false;
+  if (!std::isfinite(cx) || !std::isfinite(cy)) return false;
+  if (!std::isfinite(rate_hz) || rate_hz < 0.0) return false;
+  for (const double coefficient : distortion) {
+    if (!std::isfinite(coefficient)) return false;
+  }
+  switch (model) {
+    case DistortionModel::kNone:
+      for (const double coefficient : distortion) {
+        if (coefficient != 0.0) return false;
+      }
+      return true;
+    case DistortionModel::kRadTan:
+      return true;
+    case DistortionModel::kEquidistant:
+      return distortion[4] == 0.0;
+  }
+  return false;
+}
+
+Eigen::Vector2d CameraModel::Distort(const Eigen::Vector2d& normalised) const {
+  Eigen::Vector2d distorted = normalised;
+  switch (model) {
+    case DistortionModel::kNone:
+      break;
+    case DistortionModel::kRadTan:
+      distorted = DistortRadTan(distortion, normalised, nullptr);
+      break;
+    case DistortionModel::kEquidistant:
+      distorted = DistortEquidistant(distortion, normalised, nullptr);
+      break;
+  }
+  return Eigen::Vector2d(fx * distorted.x() + cx, fy * distorted.y() + cy);
+}
+
+std::optional<Eigen::Vector2d> CameraModel::Project(const Eigen::Vector3d& p_in_cam) const {
+  if (!(p_in_cam.z() > 0.0)) return std::nullopt;
+  return Distort(p_in_cam.head<2>() / p_in_cam.z());
+}
+
+Eigen::Vector2d CameraModel::Unproject(const Eigen::Vector2d& pixel) const {
+  const Eigen::Vector2d distorted((pixel.x() - cx) / fx, (pixel.y() - cy) / fy);
+  switch (model) {
+    case DistortionModel::kNone:
+      return distorted;
+    case DistortionModel::kRadTan: {
+      // Newton on DistortRadTan(p) = distorted, started at the distorted point.
+      Eigen::Vector2d p = distorted;
+      for (int i = 0; i < kMaxUndistortIterations; ++i) {
+        Matrix2d jacobian;
+        const Eigen::Vector2d residual = DistortRadTan(distortion, p, &jacobian) - distorted;
+        const double determinant =
+            jacobian(0, 0) * jacobian(1, 1) - jacobian(0, 1) * jacobian(1, 0);
+        const Eigen::Vector2d step(
+            (jacobian(1, 1) * residual.x() - jacobian(0, 1) * residual.y()) / determinant,
+            (jacobian(0, 0) * residual.y() - jacobian(1, 0) * residual.x()) / determinant);
+        if (!step.allFinite()) break;
+        p -= step;
+        if (step.squaredNorm() < kUndistortTolerance * kUndistortTolerance) break;
+      }
+      return p;
+    }
+    case DistortionModel::kEquidistant: {
+      const double theta_d = distorted.norm();
+      if (theta_d < kSmallRadius) return distorted;
+      // Newton on theta_d(theta) = theta_d, started at theta = theta_d.
+      double theta = std::min(theta_d, kMaxFisheyeTheta);
+      for (int i = 0; i < kMaxUndistortIterations; ++i) {
+        double derivative = 0.0;
+        const double step = (FisheyeThetaD(distortion, theta, &derivative) - theta_d) / derivative;
+        if (!std::isfinite(step)) break;
+        theta = std::clamp(theta - step, 0.0, kMaxFisheyeTheta);
+        if (std::abs(step) < kUndistortTolerance) break;
+      }
+      return distorted * (std::tan(theta) / theta_d);
+    }
+  }
+  return distorted;
+}
+
+Eigen::Matrix<double, 2, 3> CameraModel::ProjectJacobian(const Eigen::Vector3d& p_in_cam) const {
+  const double inverse_z = 1.0 / p_in_cam.z();
+  const Eigen::Vector2d normalised = p_in_cam.head<2>() * inverse_z;
+  // d normalised / d p_in_cam.
+  Eigen::Matrix<double, 2, 3> normalised_d_point;
+  normalised_d_point << inverse_z, 0.0, -normalised.x() * inverse_z,  //
+      0.0, inverse_z, -normalised.y() * inverse_z;
+  Matrix2d distorted_d_normalised = Matrix2d::Identity();
+  switch (model) {
+    case DistortionModel::kNone:
+      break;
+    case DistortionModel::kRadTan:
+      DistortRadTan(distortion, normalised, &distorted_d_normalised);
+      break;
+    case DistortionModel::kEquidistant:
+      DistortEquidistant(distortion, normalised, &distorted_d_normalised);
+      break;
+  }
+  const Eigen::DiagonalMatrix<double, 2> pixel_d_distorted(fx, fy);
+  return pixel_d_distorted * distorted_d_normalised * normalised_d_point;
+}
+
+std::string DistortionModelName(DistortionModel model) {
+  switch (model) {
+    case DistortionModel::kNone:
+      return "none";
+    case DistortionModel::kRadTan:
+      return "radtan";
+    case DistortionModel::kEquidistant:
+      return "equidistant";
+  }
+  return "unknown";
+}
+
+}  // namespace arucoslam

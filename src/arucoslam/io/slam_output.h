@@ -1,0 +1,53 @@
+// SLAM run outputs: trajectory.tum (every frame with a pose), keyframes.tum, map.ply (map
+// points) and stats.json (timings, counts, peak memory), written into one output folder.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "arucoslam/io/trajectory_io.h"
+#include "arucoslam/util/timing.h"
+
+namespace arucoslam {
+
+// What stats.json records about a run.
+struct SlamRunStats {
+  std::string dataset;  // the sequence's path
+  std::string layout;   // DatasetLayoutName
+  bool blocking = true;
+  bool markers = false;  // whether a marker map was used
+  int frames = 0;
+  int frames_tracked = 0;  // frames with a pose
+  int frames_lost = 0;
+  int losses = 0;          // transitions tracking -> lost
+  int relocalisations = 0;
+  int initialization_attempts = 0;
+  int initializations = 0;
+  int resets = 0;
+  int keyframes_inserted = 0;
+  int keyframes = 0;   // in the final map
+  int map_points = 0;  // in the final map
+  double wall_time_s = 0.0;
+  std::size_t peak_memory_bytes = 0;
+  // Per-stage timings in milliseconds, e.g. {"tracking", summary}.
+  std::vector<std::pair<std::string, TimingSummary>> timings_ms;
+};
+
+// ASCII PLY with one vertex (x y z, double) per point.
+std::string FormatPlyPoints(const std::vector<Eigen::Vector3d>& points);
+// stats.json text: {"format": "arucoslam.stats/1", "dataset", "frames": {...},
+// "tracking": {"losses", "relocalisations", ...}, "map": {...}, "timings_ms": {stage:
+// {count, mean, median, p95, max}}, "wall_time_s", "peak_memory_bytes"}.
+std::string FormatSlamStatsJson(const SlamRunStats& stats);
+
+// Writes the four files into `dir` (which must exist), each atomically.
+void WriteSlamOutput(const std::filesystem::path& dir, const Trajectory& trajectory,
+                     const Trajectory& keyframes, const std::vector<Eigen::Vector3d>& points,
+                     const SlamRunStats& stats);
+
+}  // namespace arucoslam

@@ -1,0 +1,219 @@
+#include "arucoslam/markers/camera_locator.h"
+
+#include <opencv2/calib3d.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+
+namespace arucoslam {
+
+bool CameraLocatorOptions::Check() const {
+  return inlier_threshold_px > 0.0 && ransac_iterations >= 1 && ransac_confidence > 0.0 &&
+         ransac_confidence < 1.0 && min_inlier_corners >= 4 && refine_max_iterations >= 0 &&
+         marker_pose.Check();
+}
+
+namespace {
+
+struct Correspondences {
+  std::vector<cv::Point3d> in_world;
+  std::vector<cv::Point2d> normalised;
+  std::vector<Eigen::Vector2d> pixels;
+  std::vector<int> marker_ids;  // per corner
+};
+
+struct Score {
+  int inliers = 0;
+  double cost = std::numeric_limits<double>::infinity();  // truncated squared error (MSAC)
+  bool BetterThan(const Score& other) const {
+    return inliers != other.inliers ? inliers > other.inliers : cost < other.cost;
+  }
+};
+
+// Pixel error of each correspondence under world_from_cam (infinite behind the camera).
+std::vector<double> PixelErrors(const Correspondences& c, const CameraModel& camera,
+                                const Rigid3& world_from_cam) {
+  const Rigid3 cam_from_world = world_from_cam.Inverse();
+  std::vector<double> errors(c.pixels.size(), std::numeric_limits<double>::infinity());
+  for (size_t i = 0; i < c.pixels.size(); ++i) {
+    const Eigen::Vector3d p(c.in_world[i].x, c.in_world[i].y, c.in_world[i].z);
+    const auto projected = camera.Project(cam_from_world * p);
+    if (projected) errors[i] = (*projected - c.pixels[i]).norm();
+  }
+  return errors;
+}
+
+Score ScorePose(const Correspondences& c, const CameraModel& camera, const Rigid3& world_from_cam,
+                double threshold) {
+  Score score;
+  score.cost = 0.0;
+  for (const double e : PixelErrors(c, camera, world_from_cam)) {
+    if (e < threshold) ++score.inliers;
+    score.cost += std::min(e * e, threshold * threshold);
+  }
+  return score;
+}
+
+// Levenberg-Marquardt on the inliers, in normalised coordinates.
+Rigid3 Refine(const Correspondences& c, const CameraModel& camera, const Rigid3& world_from_cam,
+              double threshold, int iterations) {
+  if (iterations <= 0) return world_from_cam;
+  const std::vector<double> errors = PixelErrors(c, camera, world_from_cam);
+  std::vector<cv::Point3d> object;
+  std::vector<cv::Point2d> image;
+  for (size_t i = 0; i < errors.size(); ++i) {
+    if (errors[i] < threshold) {
+      object.push_back(c.in_world[i]);
+      image.push_back(c.normalised[i]);
+    }
+  }
+  if (object.size() < 4) return world_from_cam;
+  cv::Mat rvec, tvec;
+  RvecTvecFromRigid(world_from_cam.Inverse(), rvec, tvec);
+  cv::solvePnPRefineLM(object, image, cv::Mat::eye(3, 3, CV_64F), cv::Mat(), rvec, tvec,
+                       cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT,
+                                        iterations, 1e-12));
+  return RigidFromRvecTvec(rvec, tvec).Inverse();
+}
+
+// Correspondences of the known markers' corners, and IPPE hypotheses from each marker.
+void CollectKnownCorners(const std::vector<MarkerDetection>& detections, const MarkerMap& map,
+                         const CameraModel& camera, const MarkerPoseOptions& pose_options,
+                         Correspondences& c, std::vector<Rigid3>& hypotheses,
+                         std::vector<MarkerPose>& marker_poses, std::set<int>& unknown) {
+  for (const MarkerDetection& detection : detections) {
+    const MarkerInfo* info = map.Find(detection.id);
+    if (info == nullptr) {
+      unknown.insert(detection.id);
+      continue;
+    }
+    const std::array<Eigen::Vector3d, 4> in_world = info->CornersInWorld();
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector2d xy = camera.Unproject(detection.corners[k]);
+      c.in_world.emplace_back(in_world[k].x(), in_world[k].y(), in_world[k].z());
+      c.normalised.emplace_back(xy.x(), xy.y());
+      c.pixels.push_back(detection.corners[k]);
+      c.marker_ids.push_back(detection.id);
+    }
+    const std::optional<MarkerPose> pose =
+        EstimateMarkerPose(detection, info->size, camera, pose_options);
+    if (!pose) continue;
+    marker_poses.push_back(*pose);
+    for (int s = 0; s < pose->num_solutions; ++s) {
+      hypotheses.push_back(info->world_from_marker * pose->solutions[s].cam_from_marker.Inverse());
+    }
+  }
+}
+
+// RANSAC PnP (SQPnP) over all corners, in normalised coordinates.
+std::optional<Rigid3> RansacPnp(const Correspondences& c, const CameraModel& camera,
+                                const CameraLocatorOptions& options) {
+  const double focal = std::max(camera.fx, camera.fy);
+  cv::Mat rvec, tvec;
+  std::vector<int> inliers;
+  const bool ok = cv::solvePnPRansac(
+      c.in_world, c.normalised, cv::Mat::eye(3, 3, CV_64F), cv::Mat(), rvec, tvec, false,
+      options.ransac_iterations, static_cast<float>(options.inlier_threshold_px / focal),
+      options.ransac_confidence, inliers, cv::SOLVEPNP_SQPNP);
+  if (!ok) return std::nullopt;
+  return RigidFromRvecTvec(rvec, tvec).Inverse();
+}
+
+// The best hypothesis by inliers then truncated cost, refined by LM while that helps.
+std::pair<Rigid3, Score> SelectAndRefine(const Correspondences& c, const CameraModel& camera,
+                                         const std::vector<Rigid3>& hypotheses,
+                                         const CameraLocatorOptions& options) {
+  const double threshold = options.inlier_threshold_px;
+  Rigid3 best = hypotheses.front();
+  Score best_score = ScorePose(c, camera, best, threshold);
+  for (const Rigid3& h : hypotheses) {
+    const Score score = ScorePose(c, camera, h, threshold);
+    if (score.BetterThan(best_score)) {
+      best = h;
+      best_score = score;
+    }
+  }
+  for (int round = 0; round < 2; ++round) {
+    const Rigid3 refined = Refine(c, camera, best, threshold, options.refine_max_iterations);
+    const Score score = ScorePose(c, camera, refined, threshold);
+    if (!(score.inliers >= best_score.inliers && score.cost <= best_score.cost + 1e-12)) break;
+    best = refined;
+    best_score = score;
+  }
+  return {best, best_score};
+}
+
+// One marker used: its IPPE ambiguity, and the other IPPE solution as the alternative.
+void FillSingleMarkerAmbiguity(const std::vector<MarkerPose>& marker_poses, const MarkerMap& map,
+                               CameraLocation& result) {
+  for (const MarkerPose& pose : marker_poses) {
+    if (pose.id != result.marker_ids.front()) continue;
+    result.quality.ambiguous = pose.ambiguous;
+    result.quality.error_ratio = pose.error_ratio;
+    if (pose.num_solutions < 2) continue;
+    const MarkerInfo* info = map.Find(pose.id);
+    const Rigid3 a = info->world_from_marker * pose.solutions[0].cam_from_marker.Inverse();
+    const Rigid3 b = info->world_from_marker * pose.solutions[1].cam_from_marker.Inverse();
+    const auto distance = [&result](const Rigid3& x) {
+      return RotationAngle(x.rotation.inverse() * result.world_from_cam.rotation);
+    };
+    result.alternative_world_from_cam = distance(a) > distance(b) ? a : b;
+  }
+}
+
+}  // namespace
+
+CameraLocation LocateCamera(const std::vector<MarkerDetection>& detections, const MarkerMap& map,
+                            const CameraModel& camera, const CameraLocatorOptions& options) {
+  CameraLocation result;
+  if (!options.Check()) {
+    result.failure = "invalid CameraLocatorOptions";
+    return result;
+  }
+  Correspondences c;
+  std::vector<Rigid3> hypotheses;
+  std::vector<MarkerPose> marker_poses;
+  std::set<int> unknown;
+  CollectKnownCorners(detections, map, camera, options.marker_pose, c, hypotheses, marker_poses,
+                      unknown);
+  result.unknown_marker_ids.assign(unknown.begin(), unknown.end());
+  result.quality.num_corners = static_cast<int>(c.pixels.size());
+  if (c.pixels.empty()) {
+    result.failure = "no known marker detected";
+    return result;
+  }
+  if (c.pixels.size() >= 8) {
+    if (const std::optional<Rigid3> pose = RansacPnp(c, camera, options)) {
+      hypotheses.push_back(*pose);
+    }
+  }
+  if (hypotheses.empty()) {
+    result.failure = "no pose hypothesis from the detected markers";
+    return result;
+  }
+  const auto [best, score] = SelectAndRefine(c, camera, hypotheses, options);
+  if (score.inliers < options.min_inlier_corners) {
+    result.failure = "too few inlier corners (" + std::to_string(score.inliers) + ")";
+    return result;
+  }
+  const std::vector<double> errors = PixelErrors(c, camera, best);
+  std::set<int> used;
+  double sum = 0.0;
+  for (size_t i = 0; i < errors.size(); ++i) {
+    if (errors[i] >= options.inlier_threshold_px) continue;
+    sum += errors[i] * errors[i];
+    used.insert(c.marker_ids[i]);
+  }
+  result.found = true;
+  result.world_from_cam = best;
+  result.marker_ids.assign(used.begin(), used.end());
+  result.quality.num_inlier_corners = score.inliers;
+  result.quality.num_markers = static_cast<int>(used.size());
+  result.quality.reprojection_rms_px = std::sqrt(sum / score.inliers);
+  if (used.size() == 1) FillSingleMarkerAmbiguity(marker_poses, map, result);
+  return result;
+}
+
+}  // namespace arucoslam

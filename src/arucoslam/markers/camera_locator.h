@@ -1,0 +1,54 @@
+// Camera pose in the world from one image's marker detections and a known MarkerMap:
+// all visible known corners in one PnP (RANSAC over hypotheses), refined by Levenberg-Marquardt.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "arucoslam/geometry/camera.h"
+#include "arucoslam/geometry/rigid3.h"
+#include "arucoslam/markers/detector.h"
+#include "arucoslam/markers/marker_map.h"
+#include "arucoslam/markers/marker_pose.h"
+
+namespace arucoslam {
+
+struct CameraLocatorOptions {
+  double inlier_threshold_px = 3.0;  // a corner is an inlier within this reprojection error
+  int ransac_iterations = 200;       // RANSAC PnP iterations when several markers are seen
+  double ransac_confidence = 0.999;  // in (0, 1)
+  int min_inlier_corners = 4;        // fewer inliers: no pose
+  int refine_max_iterations = 30;    // Levenberg-Marquardt iterations (0: no refinement)
+  MarkerPoseOptions marker_pose;     // per-marker IPPE and its ambiguity test
+
+  bool Check() const;
+};
+
+struct LocateQuality {
+  double reprojection_rms_px = 0.0;  // over inlier corners, pixels
+  int num_markers = 0;               // known markers with at least one inlier corner
+  int num_corners = 0;               // known corners given to the PnP
+  int num_inlier_corners = 0;
+  // True when the pose rests on one marker whose IPPE solutions are ambiguous: the
+  // alternative pose below then explains the image almost as well.
+  bool ambiguous = false;
+  double error_ratio = 0.0;  // one marker: IPPE best / second error; several: 0
+};
+
+struct CameraLocation {
+  bool found = false;
+  std::string failure;  // why not found (empty when found)
+  Rigid3 world_from_cam;
+  std::optional<Rigid3> alternative_world_from_cam;  // one marker only: IPPE's other solution
+  LocateQuality quality;
+  std::vector<int> marker_ids;          // known markers used (with inliers), ascending
+  std::vector<int> unknown_marker_ids;  // detected but absent from the map
+};
+
+// Never throws for expected failures (no known marker, too few inliers): `found` is false
+// and `failure` says why. Marker sizes come from the map.
+CameraLocation LocateCamera(const std::vector<MarkerDetection>& detections, const MarkerMap& map,
+                            const CameraModel& camera, const CameraLocatorOptions& options = {});
+
+}  // namespace arucoslam

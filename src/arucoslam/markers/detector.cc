@@ -1,0 +1,137 @@
+#include "arucoslam/markers/detector.h"
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "arucoslam/markers/dictionary.h"
+
+namespace arucoslam {
+
+Eigen::Vector2d MarkerDetection::Center() const {
+  return 0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
+}
+
+double MarkerDetection::Perimeter() const {
+  double perimeter = 0.0;
+  for (int i = 0; i < 4; ++i) perimeter += (corners[(i + 1) % 4] - corners[i]).norm();
+  return perimeter;
+}
+
+bool DetectorOptions::Check() const {
+  return IsDictionaryName(dictionary) && adaptive_thresh_win_size_min >= 3 &&
+         adaptive_thresh_win_size_max >= adaptive_thresh_win_size_min &&
+         adaptive_thresh_win_size_step > 0 && min_marker_perimeter_rate > 0.0 &&
+         max_marker_perimeter_rate > min_marker_perimeter_rate &&
+         polygonal_approx_accuracy_rate > 0.0 && min_corner_distance_rate >= 0.0 &&
+         min_distance_to_border >= 0 && min_marker_distance_rate >= 0.0 &&
+         corner_refinement_win_size >= 1 && corner_refinement_max_iterations >= 1 &&
+         corner_refinement_min_accuracy > 0.0 && perspective_remove_pixel_per_cell >= 1 &&
+         perspective_remove_ignored_margin_per_cell >= 0.0 &&
+         perspective_remove_ignored_margin_per_cell < 0.5 &&
+         max_erroneous_bits_in_border_rate >= 0.0 && min_otsu_std_dev >= 0.0 &&
+         error_correction_rate >= 0.0 && error_correction_rate <= 1.0 &&
+         dedup_distance_rate >= 0.0 && marker_border_bits >= 1 && (april_tag_quad_decimate == 0.0 || april_tag_quad_decimate >= 1.0) &&
+         april_tag_quad_sigma >= 0.0;
+}
+
+cv::Ptr<cv::aruco::DetectorParameters> DetectorOptions::ToOpenCv() const {
+  cv::Ptr<cv::aruco::DetectorParameters> p = cv::aruco::DetectorParameters::create();
+  p->adaptiveThreshWinSizeMin = adaptive_thresh_win_size_min;
+  p->adaptiveThreshWinSizeMax = adaptive_thresh_win_size_max;
+  p->adaptiveThreshWinSizeStep = adaptive_thresh_win_size_step;
+  p->adaptiveThreshConstant = adaptive_thresh_constant;
+  p->minMarkerPerimeterRate = min_marker_perimeter_rate;
+  p->maxMarkerPerimeterRate = max_marker_perimeter_rate;
+  p->polygonalApproxAccuracyRate = polygonal_approx_accuracy_rate;
+  p->minCornerDistanceRate = min_corner_distance_rate;
+  p->minDistanceToBorder = min_distance_to_border;
+  p->minMarkerDistanceRate = min_marker_distance_rate;
+  switch (corner_refinement) {
+    case CornerRefinement::kNone:
+      p->cornerRefinementMethod = cv::aruco::CORNER_REFINE_NONE;
+      break;
+    case CornerRefinement::kSubpix:
+      p->cornerRefinementMethod = cv::aruco::CORNER_REFINE_SUBPIX;
+      break;
+    case CornerRefinement::kContour:
+      p->cornerRefinementMethod = cv::aruco::CORNER_REFINE_CONTOUR;
+      break;
+    case CornerRefinement::kAprilTag:
+      p->cornerRefinementMethod = cv::aruco::CORNER_REFINE_APRILTAG;
+      break;
+  }
+  p->cornerRefinementWinSize = corner_refinement_win_size;
+  p->cornerRefinementMaxIterations = corner_refinement_max_iterations;
+  p->cornerRefinementMinAccuracy = corner_refinement_min_accuracy;
+  p->perspectiveRemovePixelPerCell = perspective_remove_pixel_per_cell;
+  p->perspectiveRemoveIgnoredMarginPerCell = perspective_remove_ignored_margin_per_cell;
+  p->maxErroneousBitsInBorderRate = max_erroneous_bits_in_border_rate;
+  p->minOtsuStdDev = min_otsu_std_dev;
+  p->errorCorrectionRate = error_correction_rate;
+  p->detectInvertedMarker = detect_inverted_marker;
+  p->markerBorderBits = marker_border_bits;
+  p->aprilTagQuadDecimate = static_cast<float>(april_tag_quad_decimate);
+  p->aprilTagQuadSigma = static_cast<float>(april_tag_quad_sigma);
+  return p;
+}
+
+MarkerDetector::MarkerDetector(const DetectorOptions& options) : options_(options) {
+  dictionary_ = DictionaryFromName(options.dictionary);  // InputError when unknown
+  if (!options.Check()) throw std::invalid_argument("MarkerDetector: invalid DetectorOptions");
+  parameters_ = options.ToOpenCv();
+}
+
+std::vector<MarkerDetection> RemoveDuplicateDetections(std::vector<MarkerDetection> detections,
+                                                       double distance_rate) {
+  // Larger perimeter first, so the kept one of each group is the first seen.
+  std::stable_sort(detections.begin(), detections.end(),
+                   [](const MarkerDetection& a, const MarkerDetection& b) {
+                     return a.Perimeter() > b.Perimeter();
+                   });
+  std::vector<MarkerDetection> kept;
+  for (const MarkerDetection& candidate : detections) {
+    const bool duplicate = std::any_of(kept.begin(), kept.end(), [&](const MarkerDetection& k) {
+      const double side = 0.25 * std::min(k.Perimeter(), candidate.Perimeter());
+      return k.id == candidate.id &&
+             (k.Center() - candidate.Center()).norm() < distance_rate * side;
+    });
+    if (!duplicate) kept.push_back(candidate);
+  }
+  std::sort(kept.begin(), kept.end(), [](const MarkerDetection& a, const MarkerDetection& b) {
+    if (a.id != b.id) return a.id < b.id;
+    const Eigen::Vector2d ca = a.Center(), cb = b.Center();
+    return ca.x() != cb.x() ? ca.x() < cb.x() : ca.y() < cb.y();
+  });
+  return kept;
+}
+
+std::vector<MarkerDetection> MarkerDetector::Detect(const cv::Mat& image) const {
+  if (image.empty()) return {};
+  cv::Mat gray = image;
+  if (image.channels() == 3) cv::cvtColor(image, gray, cv::COLOR_BGR2GRAY);
+  if (image.channels() == 4) cv::cvtColor(image, gray, cv::COLOR_BGRA2GRAY);
+  if (gray.depth() != CV_8U) throw std::invalid_argument("MarkerDetector: expected 8-bit image");
+  std::vector<std::vector<cv::Point2f>> corners;
+  std::vector<int> ids;
+  cv::aruco::detectMarkers(gray, dictionary_, corners, ids, parameters_);
+  // OpenCV 4.6's AprilTag path returns corners with pixel centres at (0.5, 0.5) (the apriltag
+  // library's convention; measured +0.45 px on rendered markers): shift them back.
+  const double shift = options_.corner_refinement == CornerRefinement::kAprilTag ? 0.5 : 0.0;
+  std::vector<MarkerDetection> detections;
+  detections.reserve(ids.size());
+  for (size_t i = 0; i < ids.size(); ++i) {
+    if (corners[i].size() != 4) continue;
+    MarkerDetection detection;
+    detection.id = ids[i];
+    for (int k = 0; k < 4; ++k) {
+      detection.corners[k] = {corners[i][k].x - shift, corners[i][k].y - shift};
+    }
+    detections.push_back(detection);
+  }
+  return RemoveDuplicateDetections(std::move(detections), options_.dedup_distance_rate);
+}
+
+}  // namespace arucoslam

@@ -1,0 +1,90 @@
+// MarkerDetector: finds ArUco (and AprilTag-family) markers of one dictionary in a grey
+// image with OpenCV's aruco module; returns each marker's id and its four corner pixels.
+#pragma once
+
+#include <Eigen/Core>
+#include <opencv2/aruco.hpp>
+#include <opencv2/core.hpp>
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace arucoslam {
+
+// One detected marker: corners in OpenCV order (top-left, top-right, bottom-right,
+// bottom-left of the marker as printed), pixels in the (distorted) input image, with pixel
+// centres at integer coordinates whatever the refinement.
+struct MarkerDetection {
+  int id = -1;
+  std::array<Eigen::Vector2d, 4> corners;
+
+  Eigen::Vector2d Center() const;
+  double Perimeter() const;  // pixels
+};
+
+enum class CornerRefinement { kNone, kSubpix, kContour, kAprilTag };
+
+// The OpenCV DetectorParameters that matter, with OpenCV's defaults unless said otherwise.
+struct DetectorOptions {
+  std::string dictionary = "DICT_4X4_50";  // any name of DictionaryNames()
+
+  int adaptive_thresh_win_size_min = 3;   // pixels, odd window sides tried from min to max
+  int adaptive_thresh_win_size_max = 23;  // pixels
+  int adaptive_thresh_win_size_step = 10;  // pixels
+  double adaptive_thresh_constant = 7.0;   // grey levels subtracted from the local mean
+  double min_marker_perimeter_rate = 0.03;  // of the larger image side
+  double max_marker_perimeter_rate = 4.0;   // of the larger image side
+  double polygonal_approx_accuracy_rate = 0.03;  // of the candidate's perimeter
+  double min_corner_distance_rate = 0.05;  // of the candidate's perimeter
+  int min_distance_to_border = 3;          // pixels
+  // OpenCV's default is 0.05. It is 0 here: OpenCV 4.6 then keeps the outer contour of a
+  // narrow white margin over the marker itself (DESIGN.md, known pitfalls); duplicates of
+  // one marker are removed afterwards (see dedup_distance_rate).
+  double min_marker_distance_rate = 0.0;
+  CornerRefinement corner_refinement = CornerRefinement::kSubpix;  // OpenCV default: kNone
+  int corner_refinement_win_size = 5;        // pixels (half window)
+  int corner_refinement_max_iterations = 30;
+  double corner_refinement_min_accuracy = 0.1;  // pixels
+  int perspective_remove_pixel_per_cell = 4;     // pixels per cell when decoding
+  double perspective_remove_ignored_margin_per_cell = 0.13;  // fraction of a cell
+  double max_erroneous_bits_in_border_rate = 0.35;
+  double min_otsu_std_dev = 5.0;      // grey levels
+  double error_correction_rate = 0.6;  // fraction of the dictionary's correction capacity
+  bool detect_inverted_marker = false;
+  int marker_border_bits = 1;  // black border width in cells (2 for Kalibr-style AprilGrids)
+  // kAprilTag refinement only (it then finds quads with the AprilTag algorithm): image
+  // decimation before quad detection (0 or 1: full resolution, OpenCV's default) and blur.
+  double april_tag_quad_decimate = 0.0;  // 0, or >= 1
+  double april_tag_quad_sigma = 0.0;     // Gaussian sigma, pixels, >= 0
+  // Two detections of the same id whose centres are closer than this fraction of the
+  // smaller one's side are one marker; the one with the larger perimeter is kept.
+  double dedup_distance_rate = 0.5;
+
+  bool Check() const;
+  cv::Ptr<cv::aruco::DetectorParameters> ToOpenCv() const;
+};
+
+class MarkerDetector {
+ public:
+  // Throws InputError for an unknown dictionary, std::invalid_argument for bad options.
+  explicit MarkerDetector(const DetectorOptions& options = {});
+
+  // `image`: 8-bit grey or BGR (converted to grey). Detections are sorted by id, then by
+  // position; each id appears once per physical marker.
+  std::vector<MarkerDetection> Detect(const cv::Mat& image) const;
+
+  const DetectorOptions& options() const { return options_; }
+
+ private:
+  DetectorOptions options_;
+  cv::Ptr<cv::aruco::Dictionary> dictionary_;
+  cv::Ptr<cv::aruco::DetectorParameters> parameters_;
+};
+
+// Removes duplicates (same id, centres closer than `distance_rate` x side), keeping the
+// detection with the larger perimeter. Exposed for tests.
+std::vector<MarkerDetection> RemoveDuplicateDetections(std::vector<MarkerDetection> detections,
+                                                       double distance_rate);
+
+}  // namespace arucoslam

@@ -1,0 +1,60 @@
+#include "arucoslam/optim/bundle_adjustment.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+namespace arucoslam {
+
+bool BundleAdjustmentOptions::Check() const {
+  return max_iterations >= 1 && huber_delta_px > 0.0 && chi_square_threshold > 0.0 &&
+         num_threads >= 1 && function_tolerance > 0.0;
+}
+
+bool BundleAdjustmentProblem::Check(std::string* reason) const {
+  auto fail = [reason](std::string text) {
+    if (reason != nullptr) *reason = std::move(text);
+    return false;
+  };
+  if (!intrinsics.Check()) return fail("intrinsics: focal lengths must be positive");
+  for (std::size_t i = 0; i < observations.size(); ++i) {
+    const Observation& observation = observations[i];
+    if (observation.pose_index >= poses.size()) {
+      return fail(
+          fmt::format("observation {}: pose index {} out of range", i, observation.pose_index));
+    }
+    if (observation.point_index >= points.size()) {
+      return fail(
+          fmt::format("observation {}: point index {} out of range", i, observation.point_index));
+    }
+    if (!(observation.sigma_px > 0.0) || !observation.pixel.allFinite()) {
+      return fail(fmt::format("observation {}: sigma must be positive, pixel finite", i));
+    }
+  }
+  return true;
+}
+
+std::string BundleAdjustmentSummary::BriefReport() const {
+  return fmt::format(
+      "bundle adjustment: {} residuals, {} iterations, cost {:.4g} -> {:.4g}, rms {:.3f} -> "
+      "{:.3f} px, {} outliers, {:.1f} ms ({})",
+      num_residual_blocks, num_iterations, initial_cost, final_cost, initial_rms_px, final_rms_px,
+      num_outliers, 1e3 * solve_seconds, message);
+}
+
+double ReprojectionRmsPixels(const BundleAdjustmentProblem& problem) {
+  double sum = 0.0;
+  int count = 0;
+  for (const auto& observation : problem.observations) {
+    Eigen::Vector2d residual;
+    if (ReprojectionError(problem.intrinsics, observation.pixel)
+            .Evaluate(problem.poses[observation.pose_index].cam_from_world,
+                      problem.points[observation.point_index].p_in_world, &residual)) {
+      sum += residual.squaredNorm();
+      ++count;
+    }
+  }
+  return count > 0 ? std::sqrt(sum / count) : 0.0;
+}
+
+}  // namespace arucoslam

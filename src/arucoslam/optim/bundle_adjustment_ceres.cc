@@ -1,0 +1,248 @@
+// The Ceres side of SolveBundleAdjustment: an SE(3) manifold for poses stored as
+// [qx qy qz qw tx ty tz] and an analytic reprojection cost (ReprojectionError).
+#include <ceres/ceres.h>
+
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "arucoslam/optim/bundle_adjustment.h"
+#include "arucoslam/util/timing.h"
+
+namespace arucoslam {
+namespace {
+
+constexpr int kPoseSize = 7;
+constexpr int kPoseTangentSize = 6;
+
+Rigid3 PoseFromBlock(const double* block) {
+  return Rigid3(Eigen::Quaterniond(block[3], block[0], block[1], block[2]),
+                Eigen::Vector3d(block[4], block[5], block[6]));
+}
+
+void PoseToBlock(const Rigid3& pose, double* block) {
+  const Eigen::Quaterniond q = pose.rotation.normalized();
+  block[0] = q.x();
+  block[1] = q.y();
+  block[2] = q.z();
+  block[3] = q.w();
+  block[4] = pose.translation.x();
+  block[5] = pose.translation.y();
+  block[6] = pose.translation.z();
+}
+
+// Left-multiplicative SE(3) update, x + delta = Exp(delta) * x. The cost functions report
+// their Jacobians directly w.r.t. delta in the first six ambient columns (the seventh is
+// zero), so PlusJacobian is [I6; 0] and Ceres' product gives the tangent Jacobian exactly.
+class Se3LeftManifold : public ceres::Manifold {
+ public:
+  int AmbientSize() const override { return kPoseSize; }
+  int TangentSize() const override { return kPoseTangentSize; }
+  bool Plus(const double* x, const double* delta, double* x_plus_delta) const override {
+    const Vector6d tangent = Eigen::Map<const Vector6d>(delta);
+    PoseToBlock(Rigid3::Exp(tangent) * PoseFromBlock(x), x_plus_delta);
+    return true;
+  }
+  bool PlusJacobian(const double* x, double* jacobian) const override {
+    Eigen::Map<Eigen::Matrix<double, kPoseSize, kPoseTangentSize, Eigen::RowMajor>> j(jacobian);
+    j.setZero();
+    j.topRows<kPoseTangentSize>().setIdentity();
+    return true;
+  }
+  bool Minus(const double* y, const double* x, double* y_minus_x) const override {
+    Eigen::Map<Vector6d> tangent(y_minus_x);
+    tangent = (PoseFromBlock(y) * PoseFromBlock(x).Inverse()).Log();
+    return true;
+  }
+  bool MinusJacobian(const double* x, double* jacobian) const override {
+    Eigen::Map<Eigen::Matrix<double, kPoseTangentSize, kPoseSize, Eigen::RowMajor>> j(jacobian);
+    j.setZero();
+    j.leftCols<kPoseTangentSize>().setIdentity();
+    return true;
+  }
+};
+
+// Whitened reprojection residual r / sigma over a pose block and a point block.
+class ReprojectionCost : public ceres::SizedCostFunction<2, kPoseSize, 3> {
+ public:
+  ReprojectionCost(const PinholeIntrinsics& intrinsics, const Eigen::Vector2d& pixel,
+                   double sigma_px)
+      : error_(intrinsics, pixel), inverse_sigma_(1.0 / sigma_px) {}
+
+  bool Evaluate(const double* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const Rigid3 cam_from_world = PoseFromBlock(parameters[0]);
+    const Eigen::Vector3d p_in_world(parameters[1][0], parameters[1][1], parameters[1][2]);
+    Eigen::Vector2d residual;
+    PoseJacobian d_pose;
+    PointJacobian d_point;
+    const bool want = jacobians != nullptr;
+    if (!error_.Evaluate(cam_from_world, p_in_world, &residual, want ? &d_pose : nullptr,
+                         want ? &d_point : nullptr)) {
+      // Behind the camera: no information (flagged as an outlier after the solve).
+      residual.setZero();
+      d_pose.setZero();
+      d_point.setZero();
+    }
+    Eigen::Map<Eigen::Vector2d> whitened(residuals);
+    whitened = inverse_sigma_ * residual;
+    if (want && jacobians[0] != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, 2, kPoseSize, Eigen::RowMajor>> j(jacobians[0]);
+      j.leftCols<kPoseTangentSize>() = inverse_sigma_ * d_pose;
+      j.col(kPoseTangentSize).setZero();
+    }
+    if (want && jacobians[1] != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> j(jacobians[1]);
+      j = inverse_sigma_ * d_point;
+    }
+    return true;
+  }
+
+ private:
+  ReprojectionError error_;
+  double inverse_sigma_;
+};
+
+void FlagOutliers(const BundleAdjustmentOptions& options, const BundleAdjustmentProblem& problem,
+                  BundleAdjustmentSummary* summary) {
+  summary->outliers.assign(problem.observations.size(), false);
+  summary->num_outliers = 0;
+  for (std::size_t i = 0; i < problem.observations.size(); ++i) {
+    const auto& observation = problem.observations[i];
+    Eigen::Vector2d residual;
+    const bool in_front =
+        ReprojectionError(problem.intrinsics, observation.pixel)
+            .Evaluate(problem.poses[observation.pose_index].cam_from_world,
+                      problem.points[observation.point_index].p_in_world, &residual);
+    const double chi2 = residual.squaredNorm() / (observation.sigma_px * observation.sigma_px);
+    if (!in_front || chi2 > options.chi_square_threshold) {
+      summary->outliers[i] = true;
+      ++summary->num_outliers;
+    }
+  }
+}
+
+// Parameter blocks of a problem in Ceres' layout and which of them observations use.
+struct CeresBlocks {
+  std::vector<std::array<double, kPoseSize>> poses;
+  std::vector<std::array<double, 3>> points;
+  std::vector<bool> pose_used;
+  std::vector<bool> point_used;
+
+  explicit CeresBlocks(const BundleAdjustmentProblem& problem)
+      : poses(problem.poses.size()),
+        points(problem.points.size()),
+        pose_used(problem.poses.size(), false),
+        point_used(problem.points.size(), false) {
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      PoseToBlock(problem.poses[i].cam_from_world, poses[i].data());
+    }
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      Eigen::Map<Eigen::Vector3d>(points[i].data()) = problem.points[i].p_in_world;
+    }
+  }
+
+  void CopyTo(BundleAdjustmentProblem* problem) const {
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      if (pose_used[i]) problem->poses[i].cam_from_world = PoseFromBlock(poses[i].data());
+    }
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      if (point_used[i]) {
+        problem->points[i].p_in_world = Eigen::Map<const Eigen::Vector3d>(points[i].data());
+      }
+    }
+  }
+
+  // Points first in the Schur elimination order, then poses.
+  std::shared_ptr<ceres::ParameterBlockOrdering> SchurOrdering() {
+    auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      if (point_used[i]) ordering->AddElementToGroup(points[i].data(), 0);
+    }
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      if (pose_used[i]) ordering->AddElementToGroup(poses[i].data(), 1);
+    }
+    return ordering;
+  }
+};
+
+// One residual block per observation; manifold and constancy set once per block.
+void AddResiduals(const BundleAdjustmentProblem& problem, ceres::Manifold* manifold,
+                  ceres::LossFunction* loss, CeresBlocks* blocks, ceres::Problem* ceres_problem) {
+  for (const auto& observation : problem.observations) {
+    double* pose_block = blocks->poses[observation.pose_index].data();
+    double* point_block = blocks->points[observation.point_index].data();
+    ceres_problem->AddResidualBlock(
+        new ReprojectionCost(problem.intrinsics, observation.pixel, observation.sigma_px), loss,
+        pose_block, point_block);
+    if (!blocks->pose_used[observation.pose_index]) {
+      blocks->pose_used[observation.pose_index] = true;
+      ceres_problem->SetManifold(pose_block, manifold);
+      if (problem.poses[observation.pose_index].fixed) {
+        ceres_problem->SetParameterBlockConstant(pose_block);
+      }
+    }
+    if (!blocks->point_used[observation.point_index]) {
+      blocks->point_used[observation.point_index] = true;
+      if (problem.points[observation.point_index].fixed) {
+        ceres_problem->SetParameterBlockConstant(point_block);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+BundleAdjustmentSummary SolveBundleAdjustment(const BundleAdjustmentOptions& options,
+                                              BundleAdjustmentProblem* problem) {
+  BundleAdjustmentSummary summary;
+  std::string reason;
+  if (!options.Check()) {
+    summary.message = "invalid options";
+    return summary;
+  }
+  if (!problem->Check(&reason)) {
+    summary.message = reason;
+    return summary;
+  }
+  const Stopwatch stopwatch;
+  summary.initial_rms_px = ReprojectionRmsPixels(*problem);
+
+  CeresBlocks blocks(*problem);
+  ceres::Problem::Options problem_options;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem ceres_problem(problem_options);
+  Se3LeftManifold manifold;
+  ceres::HuberLoss loss(options.huber_delta_px);
+  AddResiduals(*problem, &manifold, &loss, &blocks, &ceres_problem);
+  summary.num_residual_blocks = ceres_problem.NumResidualBlocks();
+  if (summary.num_residual_blocks == 0) {
+    summary.success = true;
+    summary.message = "no observations";
+    return summary;
+  }
+
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_SCHUR;
+  solver_options.linear_solver_ordering = blocks.SchurOrdering();
+  solver_options.max_num_iterations = options.max_iterations;
+  solver_options.function_tolerance = options.function_tolerance;
+  solver_options.num_threads = options.num_threads;
+  solver_options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary ceres_summary;
+  ceres::Solve(solver_options, &ceres_problem, &ceres_summary);
+
+  summary.success = ceres_summary.IsSolutionUsable();
+  summary.num_iterations = static_cast<int>(ceres_summary.iterations.size()) - 1;
+  summary.initial_cost = ceres_summary.initial_cost;
+  summary.final_cost = ceres_summary.final_cost;
+  summary.message = ceres_summary.message;
+  if (summary.success) blocks.CopyTo(problem);
+  summary.final_rms_px = ReprojectionRmsPixels(*problem);
+  FlagOutliers(options, *problem, &summary);
+  summary.solve_seconds = stopwatch.ElapsedSeconds();
+  return summary;
+}
+
+}  // namespace arucoslam

@@ -1,0 +1,146 @@
+#include "arucoslam/optim/local_bundle_adjustment.h"
+
+#include <map>
+#include <set>
+#include <vector>
+
+namespace arucoslam {
+namespace {
+
+// The problem plus the ids behind its indices.
+struct Snapshot {
+  BundleAdjustmentProblem problem;
+  std::vector<KeyframeId> keyframe_ids;  // per problem pose
+  std::vector<MapPointId> point_ids;     // per problem point
+  std::vector<int> keypoint_indices;     // per observation
+  int num_local = 0;
+  int num_fixed = 0;
+};
+
+std::set<KeyframeId> ChooseFixed(const MapData& data, KeyframeId current,
+                                 const std::vector<KeyframeId>& local,
+                                 const std::set<KeyframeId>& border,
+                                 const LocalBundleAdjustmentOptions& options) {
+  std::set<KeyframeId> fixed = border;
+  std::set<KeyframeId> local_sorted(local.begin(), local.end());
+  if (local_sorted.count(data.FirstKeyframe()) != 0) fixed.insert(data.FirstKeyframe());
+  for (const KeyframeId& id : local_sorted) {
+    if (static_cast<int>(fixed.size()) >= options.min_fixed_keyframes) break;
+    if (id != current) fixed.insert(id);
+  }
+  if (static_cast<int>(fixed.size()) < options.min_fixed_keyframes) fixed.insert(current);
+  return fixed;
+}
+
+Snapshot TakeSnapshot(const MapData& data, KeyframeId current,
+                      const LocalBundleAdjustmentOptions& options) {
+  Snapshot snapshot;
+  const Keyframe* keyframe = data.FindKeyframe(current);
+  if (keyframe == nullptr) return snapshot;
+  std::vector<KeyframeId> local = {current};
+  for (const KeyframeId& id :
+       data.covisibility().BestCovisible(current, options.max_covisible_keyframes)) {
+    local.push_back(id);
+  }
+  std::set<MapPointId> points;
+  for (const KeyframeId& id : local) {
+    for (const MapPointId& point : data.MapPointsOf(id)) points.insert(point);
+  }
+  const std::set<KeyframeId> local_set(local.begin(), local.end());
+  std::set<KeyframeId> border;
+  for (const MapPointId& point : points) {
+    for (const auto& [observer, index] : data.FindMapPoint(point)->observations) {
+      if (local_set.count(observer) == 0) border.insert(observer);
+    }
+  }
+  const std::set<KeyframeId> fixed = ChooseFixed(data, current, local, border, options);
+
+  snapshot.problem.intrinsics = PinholeIntrinsics::FromCamera(keyframe->camera);
+  std::map<KeyframeId, std::size_t> pose_index;
+  for (const std::set<KeyframeId>* group :
+       std::vector<const std::set<KeyframeId>*>{&local_set, &border}) {
+    for (const KeyframeId& id : *group) {
+      pose_index[id] = snapshot.problem.poses.size();
+      snapshot.problem.poses.push_back(
+          {data.FindKeyframe(id)->cam_from_world, fixed.count(id) != 0});
+      snapshot.keyframe_ids.push_back(id);
+    }
+  }
+  for (const MapPointId& point_id : points) {
+    const MapPoint* point = data.FindMapPoint(point_id);
+    const std::size_t point_index = snapshot.problem.points.size();
+    snapshot.problem.points.push_back({point->p_in_world, false});
+    snapshot.point_ids.push_back(point_id);
+    for (const auto& [observer, index] : point->observations) {
+      const Keyframe* observer_keyframe = data.FindKeyframe(observer);
+      snapshot.problem.observations.push_back({pose_index.at(observer), point_index,
+                                               observer_keyframe->UndistortedPixel(index),
+                                               observer_keyframe->SigmaPx(index)});
+      snapshot.keypoint_indices.push_back(index);
+    }
+  }
+  snapshot.num_local = static_cast<int>(local_set.size());
+  snapshot.num_fixed = static_cast<int>(fixed.size());
+  return snapshot;
+}
+
+int WriteBack(MapData& data, const Snapshot& snapshot, const BundleAdjustmentSummary& summary,
+              bool erase_outliers) {
+  const BundleAdjustmentProblem& problem = snapshot.problem;
+  for (std::size_t i = 0; i < problem.poses.size(); ++i) {
+    if (!problem.poses[i].fixed) {
+      data.SetKeyframePose(snapshot.keyframe_ids[i], problem.poses[i].cam_from_world);
+    }
+  }
+  int erased = 0;
+  if (erase_outliers) {
+    for (std::size_t k = 0; k < problem.observations.size(); ++k) {
+      if (!summary.outliers[k]) continue;
+      const KeyframeId keyframe_id = snapshot.keyframe_ids[problem.observations[k].pose_index];
+      const MapPointId point_id = snapshot.point_ids[problem.observations[k].point_index];
+      const MapPoint* point = data.FindMapPoint(point_id);
+      if (point == nullptr) continue;
+      const auto it = point->observations.find(keyframe_id);
+      if (it == point->observations.end() || it->second != snapshot.keypoint_indices[k]) continue;
+      data.EraseObservation(keyframe_id, point_id);
+      ++erased;
+    }
+  }
+  for (std::size_t j = 0; j < problem.points.size(); ++j) {
+    const MapPointId point_id = snapshot.point_ids[j];
+    const MapPoint* point = data.FindMapPoint(point_id);
+    if (point == nullptr) continue;
+    if (point->observations.empty()) {
+      data.EraseMapPoint(point_id);
+      continue;
+    }
+    data.SetMapPointPosition(point_id, problem.points[j].p_in_world);
+    data.UpdateNormalAndDepth(point_id);
+  }
+  return erased;
+}
+
+}  // namespace
+
+LocalBundleAdjustmentResult RunLocalBundleAdjustment(Map& map, KeyframeId keyframe,
+                                                     const LocalBundleAdjustmentOptions& options) {
+  LocalBundleAdjustmentResult result;
+  Snapshot snapshot =
+      map.Read([&](const MapData& data) { return TakeSnapshot(data, keyframe, options); });
+  result.num_local_keyframes = snapshot.num_local;
+  result.num_fixed_keyframes = snapshot.num_fixed;
+  result.num_points = static_cast<int>(snapshot.problem.points.size());
+  if (snapshot.problem.observations.empty()) {
+    result.summary.message = "no observations in the local window";
+    return result;
+  }
+  result.summary = SolveBundleAdjustment(options.solver, &snapshot.problem);
+  if (!result.summary.success) return result;
+  result.num_erased_observations = map.Write([&](MapData& data) {
+    return WriteBack(data, snapshot, result.summary, options.erase_outliers);
+  });
+  result.applied = true;
+  return result;
+}
+
+}  // namespace arucoslam

@@ -1,0 +1,40 @@
+// RunLocalBundleAdjustment: bundle adjustment of a keyframe's covisibility neighbourhood in
+// a Map (snapshot under a read lock, Ceres without the lock, results written back in one go).
+#pragma once
+
+#include "arucoslam/map/map.h"
+#include "arucoslam/optim/bundle_adjustment.h"
+
+namespace arucoslam {
+
+struct LocalBundleAdjustmentOptions {
+  BundleAdjustmentOptions solver;
+  // Local window: the keyframe and up to this many of its best covisible keyframes.
+  int max_covisible_keyframes = 20;
+  // Keyframes outside the window that observe its points are held fixed. When fewer than
+  // this many are fixed, the lowest-id keyframes of the window are fixed too (the current
+  // keyframe last). The map's first keyframe is always fixed.
+  int min_fixed_keyframes = 1;
+  // Erase observations the solve flags as outliers (chi-square test); points left with no
+  // observation are erased.
+  bool erase_outliers = true;
+
+  bool Check() const {
+    return solver.Check() && max_covisible_keyframes >= 0 && min_fixed_keyframes >= 0;
+  }
+};
+
+struct LocalBundleAdjustmentResult {
+  bool applied = false;  // the solve succeeded and its results were written to the map
+  int num_local_keyframes = 0;
+  int num_fixed_keyframes = 0;
+  int num_points = 0;
+  int num_erased_observations = 0;
+  BundleAdjustmentSummary summary;
+};
+
+// Keyframes and points erased by another thread during the solve are skipped on write-back.
+LocalBundleAdjustmentResult RunLocalBundleAdjustment(
+    Map& map, KeyframeId keyframe, const LocalBundleAdjustmentOptions& options = {});
+
+}  // namespace arucoslam

@@ -1,0 +1,271 @@
+#include "arucoslam/pipeline/system.h"
+
+#include <stdexcept>
+#include <utility>
+
+#include "arucoslam/feature/undistort.h"
+
+namespace arucoslam {
+
+bool SystemOptions::Check() const {
+  return extractor.Check() && initializer.Check() && initial_map.Check() && tracker.Check() &&
+         keyframes.Check() && mapper.Check() && mapper_queue_capacity >= 1 &&
+         max_initialization_gap_s > 0.0 && reset_max_keyframes >= 0;
+}
+
+System::System(const CameraModel& camera, const SystemOptions& options)
+    : camera_(camera),
+      options_(options),
+      extractor_(options.extractor),
+      initializer_(options.initializer) {
+  if (!options_.Check()) throw std::invalid_argument("System: invalid SystemOptions");
+  map_ = std::make_unique<Map>();
+  tracker_ = std::make_unique<Tracker>(*map_, options_.tracker);
+  mapper_ = std::make_unique<LocalMapper>(*map_, options_.mapper);
+  StartMappingThread();
+}
+
+System::~System() { Finish(); }
+
+void System::StartMappingThread() {
+  if (options_.blocking) return;
+  queue_ = std::make_unique<BoundedQueue<KeyframeId>>(options_.mapper_queue_capacity);
+  mapping_thread_ = std::thread([this] {
+    while (const std::optional<KeyframeId> keyframe = queue_->Pop()) {
+      MapKeyframe(*keyframe);
+      mapping_busy_ = false;
+    }
+  });
+}
+
+void System::StopMappingThread() {
+  if (!mapping_thread_.joinable()) return;
+  queue_->Close();
+  mapping_thread_.join();
+}
+
+void System::Finish() {
+  if (finished_) return;
+  finished_ = true;
+  StopMappingThread();
+}
+
+bool System::MapperIdle() const {
+  if (options_.blocking) return true;
+  return !mapping_busy_ && queue_->Size() == 0;
+}
+
+void System::MapKeyframe(KeyframeId keyframe) {
+  const Stopwatch watch;
+  mapper_->ProcessKeyframe(keyframe);
+  const double elapsed = watch.ElapsedMilliseconds();
+  std::lock_guard lock(stats_mutex_);
+  stats_.local_mapping_ms.Add(elapsed);
+}
+
+FrameReport System::ProcessImage(const cv::Mat& grey, double timestamp_s) {
+  const Stopwatch watch;
+  Frame frame;
+  frame.id = FrameId(num_frames_);
+  frame.timestamp_s = timestamp_s;
+  frame.camera = camera_;
+  frame.features = extractor_.Extract(grey);
+  UndistortFeatures(camera_, &frame.features);
+  frame.ResetMatches();
+  const double extraction = watch.ElapsedMilliseconds();
+  FrameReport report = ProcessFrame(std::move(frame));
+  std::lock_guard lock(stats_mutex_);
+  stats_.extraction_ms.Add(extraction);
+  stats_.frame_ms.Add(watch.ElapsedMilliseconds());
+  return report;
+}
+
+FrameReport System::ProcessFrame(Frame frame) {
+  if (finished_) throw std::logic_error("System::ProcessFrame after Finish");
+  const Stopwatch watch;
+  FrameReport report;
+  report.index = num_frames_++;
+  report.timestamp_s = frame.timestamp_s;
+  report.num_features = static_cast<int>(frame.features.size());
+  if (frame.map_point_ids.size() != frame.features.size()) frame.ResetMatches();
+  if (tracker_->state() == TrackingState::kNotInitialized) {
+    Initialize(frame, report);
+  } else {
+    Track(frame, report);
+  }
+  {
+    std::lock_guard lock(stats_mutex_);
+    ++stats_.num_frames;
+    if (report.cam_from_world) ++stats_.num_tracked;
+    if (report.state == TrackingState::kLost) ++stats_.num_lost;
+    stats_.tracking_ms.Add(watch.ElapsedMilliseconds());
+  }
+  if (pending_keyframe_) {
+    MapKeyframe(*pending_keyframe_);
+    pending_keyframe_.reset();
+  }
+  return report;
+}
+
+void System::Initialize(Frame& frame, FrameReport& report) {
+  report.state = TrackingState::kNotInitialized;
+  const bool enough = report.num_features >= options_.initializer.min_matches;
+  if (!init_reference_ ||
+      frame.timestamp_s - init_reference_->timestamp_s > options_.max_initialization_gap_s) {
+    if (enough) init_reference_ = frame;
+    report.message = enough ? "initialisation reference" : "too few features";
+    return;
+  }
+  {
+    std::lock_guard lock(stats_mutex_);
+    ++stats_.num_initialization_attempts;
+  }
+  const InitializationResult result =
+      initializer_.Initialize(init_reference_->features, frame.features, camera_);
+  report.message = result.message;
+  if (!result.success) {
+    if (result.failure == InitFailure::kTooFewMatches && enough) init_reference_ = frame;
+    return;
+  }
+  Frame first = *init_reference_;
+  const InitialMapResult created =
+      CreateInitialMap(*map_, first, frame, result, options_.initial_map);
+  if (!created.success) {
+    report.message = created.message;
+    return;
+  }
+  init_reference_.reset();
+  tracker_->Start(frame, created.second);
+  RecordPose(first, created.first);
+  RecordPose(frame, created.second);
+  frames_since_keyframe_ = 0;
+  last_state_ = TrackingState::kTracking;
+  report.state = TrackingState::kTracking;
+  report.cam_from_world = frame.cam_from_world;
+  report.initialized_map = true;
+  report.new_keyframe = true;
+  report.num_inliers = created.num_points;
+  report.message = "map initialised with " + std::to_string(created.num_points) + " points";
+  std::lock_guard lock(stats_mutex_);
+  ++stats_.num_initializations;
+  stats_.num_keyframes_inserted += 2;
+}
+
+void System::Track(Frame& frame, FrameReport& report) {
+  const TrackingResult result = tracker_->Track(frame);
+  report.state = result.state;
+  report.num_inliers = result.num_inliers;
+  if (result.state != TrackingState::kTracking) {
+    if (last_state_ == TrackingState::kTracking) {
+      std::lock_guard lock(stats_mutex_);
+      ++stats_.num_losses;
+    }
+    last_state_ = result.state;
+    report.message = "tracking lost";
+    if (static_cast<int>(map_->NumKeyframes()) <= options_.reset_max_keyframes) ResetMap();
+    return;
+  }
+  last_state_ = TrackingState::kTracking;
+  report.cam_from_world = frame.cam_from_world;
+  ++frames_since_keyframe_;
+  MaybeInsertKeyframe(frame, result.num_inliers, report);
+  RecordPose(frame, tracker_->reference_keyframe());
+}
+
+void System::MaybeInsertKeyframe(const Frame& frame, int num_inliers, FrameReport& report) {
+  KeyframeDecisionInput input;
+  input.frames_since_last_keyframe = frames_since_keyframe_;
+  input.num_tracked = num_inliers;
+  const int min_observations =
+      map_->NumKeyframes() <= 2 ? 2 : options_.keyframes.min_observations;
+  input.num_reference_tracked = map_->Read([&](const MapData& data) {
+    return ReferenceTrackedPoints(data, tracker_->reference_keyframe(), min_observations);
+  });
+  input.mapper_idle = MapperIdle();
+  input.mapper_has_room = options_.blocking || queue_->Size() < queue_->capacity();
+  if (!DecideKeyframe(options_.keyframes, input).insert) return;
+  const KeyframeId keyframe = InsertKeyframe(*map_, frame, tracker_->reference_keyframe());
+  tracker_->SetReferenceKeyframe(keyframe);
+  frames_since_keyframe_ = 0;
+  report.new_keyframe = true;
+  {
+    std::lock_guard lock(stats_mutex_);
+    ++stats_.num_keyframes_inserted;
+  }
+  if (options_.blocking) {
+    pending_keyframe_ = keyframe;  // mapped once the frame's tracking time is recorded
+  } else {
+    mapping_busy_ = true;
+    queue_->Push(keyframe);
+  }
+}
+
+void System::RecordPose(const Frame& frame, KeyframeId reference) {
+  TrackedPose pose;
+  pose.timestamp_s = frame.timestamp_s;
+  pose.reference = reference;
+  pose.cam_from_world = *frame.cam_from_world;
+  const std::optional<Rigid3> reference_pose = map_->Read([&](const MapData& data) {
+    const Keyframe* keyframe = data.FindKeyframe(reference);
+    return keyframe ? std::optional<Rigid3>(keyframe->cam_from_world) : std::nullopt;
+  });
+  if (!reference_pose) pose.reference = KeyframeId();
+  pose.cam_from_reference =
+      reference_pose ? pose.cam_from_world * reference_pose->Inverse() : pose.cam_from_world;
+  poses_.push_back(pose);
+}
+
+void System::ResetMap() {
+  StopMappingThread();
+  tracker_.reset();
+  mapper_.reset();
+  map_ = std::make_unique<Map>();
+  tracker_ = std::make_unique<Tracker>(*map_, options_.tracker);
+  mapper_ = std::make_unique<LocalMapper>(*map_, options_.mapper);
+  poses_.clear();
+  init_reference_.reset();
+  last_state_ = TrackingState::kNotInitialized;
+  mapping_busy_ = false;
+  StartMappingThread();
+  std::lock_guard lock(stats_mutex_);
+  ++stats_.num_resets;
+}
+
+std::vector<StampedPose> System::Trajectory() const {
+  std::vector<StampedPose> trajectory;
+  map_->Read([&](const MapData& data) {
+    for (const TrackedPose& pose : poses_) {
+      const Keyframe* reference = data.FindKeyframe(pose.reference);
+      const Rigid3 cam_from_world =
+          reference ? pose.cam_from_reference * reference->cam_from_world : pose.cam_from_world;
+      trajectory.push_back({pose.timestamp_s, cam_from_world.Inverse()});
+    }
+    return 0;
+  });
+  return trajectory;
+}
+
+std::vector<StampedPose> System::KeyframePoses() const {
+  return map_->Read([](const MapData& data) {
+    std::vector<StampedPose> poses;
+    for (const auto& [id, keyframe] : data.keyframes()) {
+      poses.push_back({keyframe.timestamp_s, keyframe.cam_from_world.Inverse()});
+    }
+    return poses;
+  });
+}
+
+std::vector<Eigen::Vector3d> System::MapPoints() const {
+  return map_->Read([](const MapData& data) {
+    std::vector<Eigen::Vector3d> points;
+    for (const auto& [id, point] : data.map_points()) points.push_back(point.p_in_world);
+    return points;
+  });
+}
+
+SystemStats System::Stats() const {
+  std::lock_guard lock(stats_mutex_);
+  return stats_;
+}
+
+}  // namespace arucoslam

@@ -1,0 +1,252 @@
+#include "arucoslam/sim/factory_world.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <opencv2/imgcodecs.hpp>
+#include <sdf/sdf.hh>
+#include <set>
+#include <sstream>
+
+#include "arucoslam/io/marker_map_json.h"
+#include "arucoslam/sim/path.h"
+#include "arucoslam/sim/world_model.h"
+#include "arucoslam/util/error.h"
+
+namespace arucoslam {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kPi = std::numbers::pi;
+
+class FactoryWorldTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    root_ = fs::temp_directory_path() / ("arucoslam_factory_test_" + std::to_string(getpid()));
+    fs::remove_all(root_);
+    fs::create_directories(root_);
+  }
+  void TearDown() override { fs::remove_all(root_); }
+
+  fs::path Write(const FactoryOptions& options, const std::string& name) {
+    const fs::path dir = root_ / name;
+    fs::create_directories(dir);
+    WriteFactoryWorld(BuildFactoryWorld(options), dir);
+    return dir;
+  }
+
+  fs::path root_;
+};
+
+std::string FileBytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  return bytes.str();
+}
+
+std::map<std::string, std::string> FolderBytes(const fs::path& dir) {
+  std::map<std::string, std::string> files;
+  for (const auto& entry : fs::recursive_directory_iterator(dir)) {
+    if (entry.is_regular_file())
+      files[fs::relative(entry.path(), dir).string()] = FileBytes(entry.path());
+  }
+  return files;
+}
+
+TEST_F(FactoryWorldTest, SameSeedGivesIdenticalFiles) {
+  FactoryOptions options;
+  options.seed = 5;
+  options.aisles = 2;
+  options.aisle_length_m = 10.0;
+  const auto a = FolderBytes(Write(options, "a"));
+  const auto b = FolderBytes(Write(options, "b"));
+  ASSERT_EQ(a.size(), b.size());
+  for (const auto& [name, bytes] : a) {
+    ASSERT_TRUE(b.count(name)) << name;
+    EXPECT_TRUE(bytes == b.at(name)) << name << " differs";
+  }
+  EXPECT_TRUE(a.count("world.sdf") && a.count("markers.json") && a.count("path.json"));
+  EXPECT_TRUE(a.count("textures/floor_0.png") && a.count("markers/0.png"));
+  options.seed = 6;
+  const auto c = FolderBytes(Write(options, "c"));
+  EXPECT_NE(a.at("textures/floor_0.png"), c.at("textures/floor_0.png"));
+  EXPECT_NE(a.at("world.sdf"), c.at("world.sdf"));
+}
+
+TEST_F(FactoryWorldTest, DefaultRouteIsAShortLoopWithATightTurn) {
+  const FactoryWorld world = BuildFactoryWorld(FactoryOptions());
+  const std::vector<RouteSample> route = PlanRoute(world.default_route);
+  // The demo sequence: at most 3 minutes of driving, aimed at 60-90 s.
+  EXPECT_LE(RouteDuration(route), 90.0);
+  EXPECT_GE(RouteDuration(route), 45.0);
+  const std::vector<TimedPose> poses = GenerateCameraPath(world.default_route, PathRun::kRepeat);
+  EXPECT_LT(
+      (poses.back().world_from_cam.translation - poses.front().world_from_cam.translation).norm(),
+      0.5);
+  double max_speed = 0.0, best_turn = 0.0;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const Eigen::Vector3d p = poses[i].world_from_cam.translation;
+    EXPECT_GE(p.z(), 0.3);
+    EXPECT_LE(p.z(), 1.0);
+    if (i > 0) {
+      max_speed = std::max(max_speed, (p - poses[i - 1].world_from_cam.translation).norm() * 30.0);
+    }
+    double travelled = 0.0, turned = 0.0;
+    for (std::size_t j = i + 1; j < poses.size() && travelled < 5.0; ++j) {
+      auto heading = [&poses](std::size_t k) {
+        const Eigen::Vector3d f = poses[k].world_from_cam.rotation * Eigen::Vector3d::UnitZ();
+        return std::atan2(f.y(), f.x());
+      };
+      travelled +=
+          (poses[j].world_from_cam.translation - poses[j - 1].world_from_cam.translation).norm();
+      turned += std::remainder(heading(j) - heading(j - 1), 2 * kPi);
+      best_turn = std::max(best_turn, std::abs(turned));
+    }
+  }
+  EXPECT_LE(max_speed, 1.02);
+  EXPECT_GE(best_turn * 180.0 / kPi, 150.0);
+}
+
+// Every dock the route visits is approached head-on: for at least 2 m of driving the marker
+// is ahead of the camera, within 25 degrees of its axis, with its +z facing the camera.
+TEST_F(FactoryWorldTest, DockMarkersFaceTheApproach) {
+  FactoryOptions options;
+  options.markers_per_dock = 2;
+  const FactoryWorld world = BuildFactoryWorld(options);
+  const std::vector<TimedPose> poses = GenerateCameraPath(world.default_route, PathRun::kTeach);
+  int visited = 0;
+  for (const FactoryDock& dock : world.docks) {
+    ASSERT_EQ(dock.marker_ids.size(), 2u);
+    for (const int id : dock.marker_ids) {
+      const MarkerInfo& marker = world.markers.markers.at(id);
+      const Eigen::Vector3d z = marker.world_from_marker.rotation * Eigen::Vector3d::UnitZ();
+      const Eigen::Vector3d y = marker.world_from_marker.rotation * Eigen::Vector3d::UnitY();
+      EXPECT_NEAR(z.head<2>().dot(dock.facing), 1.0, 1e-12);  // out of the board
+      EXPECT_NEAR(y.z(), 1.0, 1e-12);                         // upright
+      EXPECT_NEAR(marker.world_from_marker.translation.z(), options.camera_height_m, 1e-12);
+      double facing_distance = 0.0;
+      for (std::size_t i = 1; i < poses.size(); ++i) {
+        const Rigid3& cam = poses[i].world_from_cam;
+        const Eigen::Vector3d to_marker = marker.world_from_marker.translation - cam.translation;
+        const Eigen::Vector3d forward = cam.rotation * Eigen::Vector3d::UnitZ();
+        if (forward.dot(to_marker.normalized()) > std::cos(25.0 * kPi / 180) &&
+            z.dot(-to_marker.normalized()) > std::cos(25.0 * kPi / 180) && to_marker.norm() < 8.0) {
+          facing_distance += (cam.translation - poses[i - 1].world_from_cam.translation).norm();
+        }
+      }
+      EXPECT_EQ(facing_distance >= 2.0, dock.on_default_route)
+          << dock.name << " " << facing_distance;
+    }
+    visited += dock.on_default_route;
+  }
+  EXPECT_EQ(visited, 2);
+  EXPECT_EQ(world.docks.size(), 2u * (options.aisles + 1));
+}
+
+// The robot (0.3 m either side of the camera) never drives into anything that stands on
+// the floor below camera height.
+TEST_F(FactoryWorldTest, RouteKeepsClearOfSolids) {
+  const FactoryWorld world = BuildFactoryWorld(FactoryOptions());
+  const std::vector<RouteSample> route = PlanRoute(world.default_route);
+  for (const FactoryModel& model : world.models) {
+    for (const FactoryVisual& visual : model.visuals) {
+      const Rigid3 world_from_visual = model.world_from_model * visual.model_from_visual;
+      const Eigen::Vector3d half = visual.size / 2;
+      const double bottom = world_from_visual.translation.z() - half.z();
+      if (bottom > 1.0 || world_from_visual.translation.z() + half.z() < 0.05) continue;
+      for (std::size_t i = 0; i < route.size(); i += 10) {
+        const Eigen::Vector3d p =
+            world_from_visual.Inverse() *
+            Eigen::Vector3d(route[i].x, route[i].y, world_from_visual.translation.z());
+        const bool inside = std::abs(p.x()) < half.x() + 0.3 && std::abs(p.y()) < half.y() + 0.3;
+        ASSERT_FALSE(inside) << model.name << "::" << visual.name << " at route distance "
+                             << route[i].distance_m;
+      }
+    }
+  }
+}
+
+Eigen::Quaterniond ToEigen(const ignition::math::Quaterniond& q) {
+  return Eigen::Quaterniond(q.W(), q.X(), q.Y(), q.Z());
+}
+
+TEST_F(FactoryWorldTest, SdformatParsesTheWorldAndMarkerPosesMatchTheJson) {
+  FactoryOptions options;
+  options.aisles = 2;
+  options.aisle_length_m = 12.0;
+  options.markers_per_dock = 2;
+  options.texture = TextureLevel::kHigh;
+  const fs::path dir = Write(options, "sdf");
+  sdf::Root root;
+  const sdf::Errors errors = root.Load((dir / "world.sdf").string());
+  for (const sdf::Error& error : errors) ADD_FAILURE() << error.Message();
+  ASSERT_EQ(root.WorldCount(), 1u);
+  const sdf::World* sdf_world = root.WorldByIndex(0);
+  const MarkerMap markers = ReadMarkerMapJson(dir / "markers.json");
+  EXPECT_EQ(markers.markers.size(), 12u);  // 2 lanes + corridor, 2 ends, 2 per dock
+  for (const auto& [id, marker] : markers.markers) {
+    const sdf::Model* model = sdf_world->ModelByName("marker_" + std::to_string(id));
+    ASSERT_NE(model, nullptr) << id;
+    EXPECT_TRUE(model->Static());
+    const ignition::math::Pose3d pose = model->RawPose();
+    const Eigen::Vector3d position(pose.Pos().X(), pose.Pos().Y(), pose.Pos().Z());
+    EXPECT_LT((position - marker.world_from_marker.translation).norm(), 1e-9) << id;
+    EXPECT_LT(RotationAngle(ToEigen(pose.Rot()).inverse() * marker.world_from_marker.rotation),
+              1e-9)
+        << id;
+    EXPECT_FALSE(cv::imread((dir / "markers" / (std::to_string(id) + ".png")).string()).empty());
+  }
+  // Every texture named exists, and textures stay small (the renderer loads them all).
+  std::set<std::string> textures;
+  for (uint64_t m = 0; m < sdf_world->ModelCount(); ++m) {
+    const sdf::Link* link = sdf_world->ModelByIndex(m)->LinkByIndex(0);
+    for (uint64_t v = 0; v < link->VisualCount(); ++v) {
+      const sdf::Material* material = link->VisualByIndex(v)->Material();
+      ASSERT_NE(material, nullptr);
+      if (material->PbrMaterial() == nullptr) continue;
+      textures.insert(material->PbrMaterial()->Workflow(sdf::PbrWorkflowType::METAL)->AlbedoMap());
+    }
+  }
+  EXPECT_GT(textures.size(), 20u);
+  for (const std::string& texture : textures) {
+    const cv::Mat image = cv::imread((dir / texture).string());
+    ASSERT_FALSE(image.empty()) << texture;
+    if (texture.rfind("textures/floor", 0) != 0) {
+      EXPECT_LE(std::max(image.cols, image.rows), 1024) << texture;
+    }
+  }
+  // The renderer's loader reads the same world: one primitive per visual.
+  const FactoryWorld world = BuildFactoryWorld(options);
+  std::size_t visuals = world.markers.markers.size();
+  for (const FactoryModel& model : world.models) visuals += model.visuals.size();
+  EXPECT_EQ(LoadWorldModel(dir / "world.sdf").primitives.size(), visuals);
+}
+
+TEST_F(FactoryWorldTest, MarkersOffAndBadOptions) {
+  FactoryOptions options;
+  options.markers = false;
+  const FactoryWorld world = BuildFactoryWorld(options);
+  EXPECT_TRUE(world.markers.markers.empty());
+  EXPECT_EQ(world.docks.size(), 8u);
+  options.markers = true;
+  options.aisles = 8;
+  options.markers_per_dock = 3;  // 18 docks x 3 > 50 ids of DICT_4X4_50
+  EXPECT_THROW(BuildFactoryWorld(options), InputError);
+  options.dictionary = "DICT_6X6_250";
+  EXPECT_EQ(BuildFactoryWorld(options).markers.markers.size(), 54u);
+  options.dictionary = "DICT_NOPE";
+  EXPECT_THROW(BuildFactoryWorld(options), InputError);
+  EXPECT_THROW(TextureLevelFromName("shiny"), InputError);
+  EXPECT_EQ(TextureLevelFromName("high"), TextureLevel::kHigh);
+  FactoryOptions bad;
+  bad.aisles = 0;
+  EXPECT_THROW(BuildFactoryWorld(bad), InputError);
+}
+
+}  // namespace
+}  // namespace arucoslam

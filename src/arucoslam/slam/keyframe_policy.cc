@@ -1,0 +1,40 @@
+#include "arucoslam/slam/keyframe_policy.h"
+
+namespace arucoslam {
+
+bool KeyframePolicyOptions::Check() const {
+  return min_frames_between >= 0 && max_frames_between >= min_frames_between &&
+         tracked_ratio > 0.0 && tracked_ratio <= 1.0 && min_observations >= 1 &&
+         min_tracked_points >= 0;
+}
+
+KeyframeDecision DecideKeyframe(const KeyframePolicyOptions& options,
+                                const KeyframeDecisionInput& input) {
+  if (input.num_tracked <= options.min_tracked_points) return {false, "too-few"};
+  const bool ratio_low =
+      input.num_tracked < options.tracked_ratio * input.num_reference_tracked;
+  if (!ratio_low) return {false, "ratio-high"};
+  const bool waited_long = input.frames_since_last_keyframe >= options.max_frames_between;
+  const bool may_when_idle = input.frames_since_last_keyframe >= options.min_frames_between;
+  if (input.mapper_idle && may_when_idle) return {true, "ratio"};
+  if (waited_long && input.mapper_has_room) return {true, "max-frames"};
+  return {false, input.mapper_idle ? "too-soon" : "busy"};
+}
+
+int ReferenceTrackedPoints(const MapData& data, KeyframeId keyframe, int min_observations) {
+  const Keyframe* reference = data.FindKeyframe(keyframe);
+  if (reference == nullptr) return 0;
+  int count = 0;
+  for (const MapPointId& id : reference->map_point_ids) {
+    const MapPoint* point = data.FindMapPoint(id);
+    if (point != nullptr && point->NumObservations() >= min_observations) ++count;
+  }
+  return count;
+}
+
+KeyframeId InsertKeyframe(Map& map, const Frame& frame, KeyframeId parent_hint) {
+  Keyframe keyframe = Keyframe::FromFrame(frame);
+  return map.Write([&](MapData& data) { return data.AddKeyframe(std::move(keyframe), parent_hint); });
+}
+
+}  // namespace arucoslam

@@ -1,0 +1,55 @@
+// KeyframePolicy: decides whether a tracked frame becomes a keyframe (tracked-point ratio
+// against the reference keyframe, frames since the last keyframe, local mapper busy).
+#pragma once
+
+#include <string>
+
+#include "arucoslam/map/map.h"
+
+namespace arucoslam {
+
+struct KeyframePolicyOptions {
+  // Frames that must pass after a keyframe before the next one may be inserted while the
+  // local mapper is idle (0: the very next frame may be one).
+  int min_frames_between = 0;
+  // After this many frames a keyframe is inserted even if the mapper is busy, provided its
+  // queue has room (ORB-SLAM uses the frame rate: one second).
+  int max_frames_between = 20;
+  // Insert when the frame tracks fewer than this fraction of the points the reference
+  // keyframe observes with at least `min_observations` observations (0.9 for monocular).
+  double tracked_ratio = 0.9;
+  // Points of the reference keyframe count when observed by at least this many keyframes
+  // (2 while the map holds at most two keyframes).
+  int min_observations = 3;
+  // A frame tracking this many inliers or fewer never becomes a keyframe (unreliable pose).
+  int min_tracked_points = 15;
+
+  bool Check() const;
+};
+
+// What the policy looks at for one tracked frame.
+struct KeyframeDecisionInput {
+  int frames_since_last_keyframe = 0;
+  int num_tracked = 0;            // the frame's inlier matches to map points
+  int num_reference_tracked = 0;  // ReferenceTrackedPoints() of its reference keyframe
+  bool mapper_idle = true;        // nothing queued and nothing being processed
+  bool mapper_has_room = true;    // the mapper's queue can take one more keyframe
+};
+
+struct KeyframeDecision {
+  bool insert = false;
+  std::string reason;  // one word for logs: "ratio", "max-frames", "busy", "too-few", ...
+};
+
+KeyframeDecision DecideKeyframe(const KeyframePolicyOptions& options,
+                                const KeyframeDecisionInput& input);
+
+// Points of `keyframe` observed by at least `min_observations` keyframes (0 when unknown).
+int ReferenceTrackedPoints(const MapData& data, KeyframeId keyframe, int min_observations);
+
+// Stores a keyframe made from a tracked `frame` (its non-outlier matches become
+// observations; covisibility edges and spanning-tree parent follow, `parent_hint` being the
+// tracker's reference keyframe). Returns the new id.
+KeyframeId InsertKeyframe(Map& map, const Frame& frame, KeyframeId parent_hint);
+
+}  // namespace arucoslam

@@ -1,0 +1,123 @@
+#include "arucoslam/slam/local_mapper.h"
+
+#include <algorithm>
+
+namespace arucoslam {
+
+bool LocalMapperOptions::Check() const {
+  return triangulation_neighbours >= 0 && min_baseline_depth_ratio >= 0.0 &&
+         max_match_distance >= 0 && match_ratio > 0.0 && match_ratio <= 1.0 &&
+         epipolar_chi2 > 0.0 && min_epipole_distance_px >= 0.0 && max_parallax_cos > 0.0 &&
+         max_parallax_cos < 1.0 && reprojection_chi2 > 0.0 && scale_consistency_factor >= 1.0 &&
+         fusion_neighbours >= 0 && fusion_radius_px > 0.0 && fusion_max_distance >= 0 &&
+         min_found_ratio >= 0.0 && min_found_ratio <= 1.0 && min_point_observations >= 1 &&
+         bundle_adjustment.Check() && redundant_fraction > 0.0 && redundant_fraction <= 1.0 &&
+         redundant_observers >= 1;
+}
+
+LocalMapper::LocalMapper(Map& map, const LocalMapperOptions& options)
+    : map_(map), options_(options) {}
+
+LocalMappingResult LocalMapper::ProcessKeyframe(KeyframeId keyframe) {
+  LocalMappingResult result;
+  const bool exists =
+      map_.Read([&](const MapData& data) { return data.FindKeyframe(keyframe) != nullptr; });
+  if (!exists) return result;
+  ++num_processed_;
+  result.processed = true;
+  result.num_refreshed_points = RefreshKeyframePoints(keyframe);
+  result.num_culled_points = CullRecentPoints();
+  result.num_new_points = TriangulateNewPoints(keyframe);
+  result.num_fused_points = FuseDuplicates(keyframe);
+  if (options_.run_bundle_adjustment && map_.NumKeyframes() > 2) {
+    result.bundle_adjustment =
+        RunLocalBundleAdjustment(map_, keyframe, options_.bundle_adjustment);
+  }
+  if (options_.cull_keyframes) result.num_culled_keyframes = CullRedundantKeyframes(keyframe);
+  return result;
+}
+
+int LocalMapper::RefreshKeyframePoints(KeyframeId keyframe) {
+  return map_.Write([&](MapData& data) {
+    const std::vector<MapPointId> points = data.MapPointsOf(keyframe);
+    for (const MapPointId& id : points) {
+      data.UpdateNormalAndDepth(id);
+      data.UpdateDescriptor(id);
+    }
+    return static_cast<int>(points.size());
+  });
+}
+
+int LocalMapper::CullRecentPoints() {
+  return map_.Write([&](MapData& data) {
+    int culled = 0;
+    std::vector<std::pair<MapPointId, int>> kept;
+    for (const auto& [id, created] : recent_points_) {
+      const MapPoint* point = data.FindMapPoint(id);
+      if (point == nullptr) continue;
+      const int age = num_processed_ - created;
+      if (point->FoundRatio() < options_.min_found_ratio ||
+          (age >= 2 && point->NumObservations() < options_.min_point_observations)) {
+        data.EraseMapPoint(id);
+        ++culled;
+      } else if (age < 3) {
+        kept.emplace_back(id, created);
+      }
+    }
+    recent_points_ = std::move(kept);
+    return culled;
+  });
+}
+
+namespace {
+
+// Whether `candidate` has more than `fraction` of its points seen by at least `observers`
+// other keyframes at the same or a finer scale (level at most one above).
+bool IsRedundant(const MapData& data, const Keyframe& candidate, double fraction,
+                 int observers) {
+  int num_points = 0;
+  int num_redundant = 0;
+  for (std::size_t i = 0; i < candidate.map_point_ids.size(); ++i) {
+    const MapPoint* point = data.FindMapPoint(candidate.map_point_ids[i]);
+    if (point == nullptr) continue;
+    ++num_points;
+    if (point->NumObservations() <= observers) continue;
+    const int level = candidate.features.keypoints[i].octave;
+    int count = 0;
+    for (const auto& [other, index] : point->observations) {
+      if (other == candidate.id) continue;
+      if (data.FindKeyframe(other)->features.keypoints[index].octave <= level + 1) ++count;
+    }
+    if (count >= observers) ++num_redundant;
+  }
+  return num_points > 0 && num_redundant > fraction * num_points;
+}
+
+}  // namespace
+
+int LocalMapper::CullRedundantKeyframes(KeyframeId keyframe) {
+  // One keyframe at a time: each erasure changes what the next candidates share.
+  return map_.Write([&](MapData& data) {
+    if (data.FindKeyframe(keyframe) == nullptr) return 0;
+    std::vector<KeyframeId> candidates;
+    for (const auto& [candidate, weight] : data.covisibility().Neighbours(keyframe)) {
+      // Only older keyframes: newer ones may still wait in the mapper's queue.
+      if (candidate != data.FirstKeyframe() && candidate < keyframe) {
+        candidates.push_back(candidate);
+      }
+    }
+    int erased = 0;
+    for (const KeyframeId& id : candidates) {
+      const Keyframe* candidate = data.FindKeyframe(id);
+      if (candidate == nullptr ||
+          !IsRedundant(data, *candidate, options_.redundant_fraction,
+                       options_.redundant_observers)) {
+        continue;
+      }
+      erased += data.EraseKeyframe(id) ? 1 : 0;
+    }
+    return erased;
+  });
+}
+
+}  // namespace arucoslam

@@ -1,0 +1,87 @@
+// LocalMapper: the local mapping of one new keyframe, synchronously: refresh its points,
+// cull bad recent points, triangulate new points with covisible keyframes, fuse duplicates,
+// run local bundle adjustment and cull redundant keyframes. pipeline/ runs it on a thread.
+#pragma once
+
+#include <utility>
+#include <vector>
+
+#include "arucoslam/map/map.h"
+#include "arucoslam/optim/local_bundle_adjustment.h"
+
+namespace arucoslam {
+
+struct LocalMapperOptions {
+  // Triangulation: the new keyframe is paired with up to this many best covisible keyframes.
+  int triangulation_neighbours = 10;
+  // A pair is skipped when baseline / median scene depth of the neighbour is below this.
+  double min_baseline_depth_ratio = 0.01;
+  int max_match_distance = 50;   // bits, descriptor distance of a triangulation match
+  double match_ratio = 0.8;      // best < ratio * second best among epipolar candidates
+  // Epipolar test: squared distance to the epipolar line below chi2(1 dof, 95%) x sigma^2.
+  double epipolar_chi2 = 3.841;
+  // Candidates closer than this x scale(level) pixels to the epipole are skipped.
+  double min_epipole_distance_px = 10.0;
+  // Rays must make an angle with cosine below this (0.9998: about 1.15 degrees).
+  double max_parallax_cos = 0.9998;
+  // Reprojection test per view: squared error below chi2(2 dof, 95%) x sigma^2.
+  double reprojection_chi2 = 5.991;
+  // Scale consistency: distance ratio and pyramid scale ratio may differ by this x the
+  // pyramid's scale factor.
+  double scale_consistency_factor = 1.5;
+  // Fusion: the new keyframe's points are projected into up to this many neighbours (and
+  // their points into it) and matched within this radius x scale(level), pixels.
+  int fusion_neighbours = 20;
+  double fusion_radius_px = 3.0;
+  int fusion_max_distance = 50;  // bits
+  // Recent point culling: found/visible below this ratio, or fewer than
+  // `min_point_observations` observations two keyframes after creation, erases a point.
+  double min_found_ratio = 0.25;
+  int min_point_observations = 3;
+  bool run_bundle_adjustment = true;
+  LocalBundleAdjustmentOptions bundle_adjustment;
+  // Keyframe culling: a covisible keyframe (not the first) is erased when this fraction of
+  // its points are seen, at the same or a finer scale, by at least `redundant_observers`
+  // other keyframes.
+  double redundant_fraction = 0.9;
+  int redundant_observers = 3;
+  bool cull_keyframes = true;
+
+  bool Check() const;
+};
+
+struct LocalMappingResult {
+  bool processed = false;  // false when the keyframe no longer exists
+  int num_refreshed_points = 0;
+  int num_culled_points = 0;
+  int num_new_points = 0;
+  int num_fused_points = 0;
+  int num_culled_keyframes = 0;
+  LocalBundleAdjustmentResult bundle_adjustment;
+};
+
+class LocalMapper {
+ public:
+  explicit LocalMapper(Map& map, const LocalMapperOptions& options = {});
+
+  // Runs every step for `keyframe`, which tracking has just inserted into the map.
+  LocalMappingResult ProcessKeyframe(KeyframeId keyframe);
+
+  // The steps, public for tests. Each returns how many points or keyframes it changed.
+  int RefreshKeyframePoints(KeyframeId keyframe);
+  int CullRecentPoints();
+  int TriangulateNewPoints(KeyframeId keyframe);
+  int FuseDuplicates(KeyframeId keyframe);
+  int CullRedundantKeyframes(KeyframeId keyframe);
+
+  const LocalMapperOptions& options() const { return options_; }
+
+ private:
+  Map& map_;
+  LocalMapperOptions options_;
+  int num_processed_ = 0;  // keyframes processed so far
+  // Points created here, with the value of num_processed_ when they were made.
+  std::vector<std::pair<MapPointId, int>> recent_points_;
+};
+
+}  // namespace arucoslam

@@ -1,0 +1,324 @@
+#include "arucoslam/slam/local_mapper.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+#include <random>
+
+#include "arucoslam/slam/keyframe_policy.h"
+#include "arucoslam/slam/tracker.h"
+
+namespace arucoslam {
+namespace {
+
+// Points with random descriptors in front of a camera moving along world x (0.05 m per
+// frame); each frame sees the points in its image with 0.3 px noise and 3 flipped descriptor
+// bits, plus 100 distractors. Keypoint i's true point is truth[i] (-1: distractor).
+class Scene {
+ public:
+  explicit Scene(std::uint32_t seed) : random_(seed) {
+    std::uniform_real_distribution<double> x(-4.0, 6.0), y(-3.0, 3.0), z(4.0, 10.0);
+    for (int j = 0; j < 1200; ++j) {
+      points_.emplace_back(x(random_), y(random_), z(random_));
+      OrbDescriptor d;
+      for (auto& byte : d) byte = static_cast<std::uint8_t>(random_() & 0xff);
+      descriptors_.push_back(d);
+    }
+    camera_.width = 640;
+    camera_.height = 480;
+    camera_.fx = camera_.fy = 500.0;
+    camera_.cx = 319.5;
+    camera_.cy = 239.5;
+  }
+
+  Rigid3 CamFromWorld(int t) const {
+    return Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.05 * t, 0.0, 0.0)).Inverse();
+  }
+
+  Frame MakeFrame(int t, std::vector<int>* truth) {
+    const Rigid3 cam_from_world = CamFromWorld(t);
+    std::normal_distribution<double> noise(0.0, 0.3);
+    std::uniform_real_distribution<double> u(20.0, 620.0), v(20.0, 460.0);
+    std::vector<std::pair<Eigen::Vector2d, int>> entries;
+    for (std::size_t j = 0; j < points_.size(); ++j) {
+      const auto pixel = camera_.Project(cam_from_world * points_[j]);
+      if (!pixel || !camera_.InImage(*pixel, 20.0)) continue;
+      entries.emplace_back(*pixel + Eigen::Vector2d(noise(random_), noise(random_)), j);
+    }
+    for (int k = 0; k < 100; ++k) entries.emplace_back(Eigen::Vector2d(u(random_), v(random_)), -1);
+    std::shuffle(entries.begin(), entries.end(), random_);
+    Frame frame;
+    frame.id = FrameId(t);
+    frame.timestamp_s = 0.05 * t;
+    frame.camera = camera_;
+    frame.features.pyramid = ScalePyramid::Make(8, 1.2);
+    frame.features.image_width = camera_.width;
+    frame.features.image_height = camera_.height;
+    frame.features.descriptors = cv::Mat(static_cast<int>(entries.size()), kOrbDescriptorBytes, CV_8U);
+    truth->clear();
+    for (std::size_t i = 0; i < entries.size(); ++i) {
+      const auto& [pixel, j] = entries[i];
+      cv::KeyPoint keypoint(static_cast<float>(pixel.x()), static_cast<float>(pixel.y()), 31.0f, 0.0f);
+      keypoint.octave = 0;
+      frame.features.keypoints.push_back(keypoint);
+      frame.features.undistorted.push_back(camera_.Unproject(pixel));
+      OrbDescriptor d;
+      if (j >= 0) {
+        d = descriptors_[j];
+        for (int flip = 0; flip < 3; ++flip) {
+          const int bit = static_cast<int>(random_() % 256);
+          d[bit / 8] ^= static_cast<std::uint8_t>(1u << (bit % 8));
+        }
+      } else {
+        for (auto& byte : d) byte = static_cast<std::uint8_t>(random_() & 0xff);
+      }
+      std::copy(d.begin(), d.end(), frame.features.descriptors.ptr(static_cast<int>(i)));
+      truth->push_back(j);
+    }
+    frame.ResetMatches();
+    frame.cam_from_world = cam_from_world;
+    return frame;
+  }
+
+  const std::vector<Eigen::Vector3d>& points() const { return points_; }
+
+ private:
+  std::mt19937 random_;
+  CameraModel camera_;
+  std::vector<Eigen::Vector3d> points_;
+  std::vector<OrbDescriptor> descriptors_;
+};
+
+struct SceneKeyframe {
+  KeyframeId id;
+  std::vector<int> truth;
+};
+
+// Keyframes at the true poses of `times`; every true point seen by all of them whose index
+// passes `share(j)` becomes a map point at its true position observed by each.
+std::vector<SceneKeyframe> BuildMap(Scene& scene, Map& map, const std::vector<int>& times,
+                                    const std::function<bool(int)>& share) {
+  std::vector<SceneKeyframe> keyframes;
+  std::vector<std::map<int, int>> index_of;
+  std::vector<Frame> frames;
+  for (int t : times) {
+    SceneKeyframe keyframe;
+    frames.push_back(scene.MakeFrame(t, &keyframe.truth));
+    std::map<int, int> index;
+    for (std::size_t i = 0; i < keyframe.truth.size(); ++i) {
+      if (keyframe.truth[i] >= 0) index[keyframe.truth[i]] = static_cast<int>(i);
+    }
+    index_of.push_back(index);
+    keyframes.push_back(keyframe);
+  }
+  map.Write([&](MapData& data) {
+    for (std::size_t k = 0; k < frames.size(); ++k) {
+      keyframes[k].id = data.AddKeyframe(Keyframe::FromFrame(frames[k]));
+    }
+    for (const auto& [j, index0] : index_of[0]) {
+      bool everywhere = share(j);
+      for (const auto& index : index_of) everywhere = everywhere && index.count(j) != 0;
+      if (!everywhere) continue;
+      MapPoint point;
+      point.p_in_world = scene.points()[j];
+      point.reference_keyframe = keyframes[0].id;
+      const MapPointId id = data.AddMapPoint(point);
+      for (std::size_t k = 0; k < frames.size(); ++k) {
+        data.AddObservation(keyframes[k].id, index_of[k].at(j), id);
+      }
+      data.UpdateDescriptor(id);
+      data.UpdateNormalAndDepth(id);
+    }
+  });
+  return keyframes;
+}
+
+// Per map point of the map: the true point index of each observing keypoint.
+std::vector<std::vector<int>> TruthOfPoints(const Map& map, const std::vector<SceneKeyframe>& kfs,
+                                            std::vector<Eigen::Vector3d>* positions) {
+  std::map<KeyframeId, const std::vector<int>*> truth;
+  for (const SceneKeyframe& kf : kfs) truth[kf.id] = &kf.truth;
+  return map.Read([&](const MapData& data) {
+    std::vector<std::vector<int>> result;
+    for (const auto& [id, point] : data.map_points()) {
+      std::vector<int> seen;
+      for (const auto& [keyframe, index] : point.observations) seen.push_back((*truth.at(keyframe))[index]);
+      result.push_back(seen);
+      positions->push_back(point.p_in_world);
+    }
+    return result;
+  });
+}
+
+TEST(LocalMapper, OptionsCheck) {
+  EXPECT_TRUE(LocalMapperOptions().Check());
+  LocalMapperOptions options;
+  options.max_parallax_cos = 1.0;
+  EXPECT_FALSE(options.Check());
+}
+
+TEST(LocalMapper, TriangulatesNewPointsWithinBoundOfTruth) {
+  Scene scene(7);
+  Map map;
+  // A third of the common points are mapped; the rest must be triangulated (0.5 m baseline).
+  const auto keyframes = BuildMap(scene, map, {0, 10}, [](int j) { return j % 3 == 0; });
+  const std::size_t seeded = map.NumMapPoints();
+  ASSERT_GT(seeded, 100u);
+  LocalMapper mapper(map);
+  const int created = mapper.TriangulateNewPoints(keyframes[1].id);
+  // About twice as many common points were left unmapped as were seeded.
+  EXPECT_GT(created, static_cast<int>(1.5 * seeded));
+  EXPECT_EQ(map.NumMapPoints(), seeded + created);
+  EXPECT_EQ(map.Read([](const MapData& data) { return data.CheckInvariants(); }), "");
+  std::vector<Eigen::Vector3d> positions;
+  const auto truth = TruthOfPoints(map, keyframes, &positions);
+  int wrong = 0;
+  std::vector<double> relative_errors;
+  for (std::size_t k = 0; k < truth.size(); ++k) {
+    ASSERT_EQ(truth[k].size(), 2u);
+    if (truth[k][0] < 0 || truth[k][0] != truth[k][1]) {
+      ++wrong;
+      continue;
+    }
+    const Eigen::Vector3d& p = scene.points()[truth[k][0]];
+    relative_errors.push_back((positions[k] - p).norm() / p.z());
+  }
+  EXPECT_LE(wrong, created / 100);  // at most 1% wrong associations
+  std::sort(relative_errors.begin(), relative_errors.end());
+  // Depth noise for 0.3 px at 500 px focal length, 0.5 m baseline and 4-10 m depth is about
+  // z / 830 m: median 0.5 %, rare tails of a few percent.
+  EXPECT_LT(relative_errors[relative_errors.size() / 2], 0.01);
+  EXPECT_LT(relative_errors[relative_errors.size() * 95 / 100], 0.03);
+}
+
+TEST(LocalMapper, FusesDuplicatePoints) {
+  Scene scene(11);
+  Map map;
+  const auto keyframes = BuildMap(scene, map, {0, 6}, [](int j) { return j % 2 == 0; });
+  // Duplicates: for 60 true points seen by both, one point per keyframe instead of one shared.
+  std::vector<std::pair<int, int>> pairs;
+  for (std::size_t i = 0; i < keyframes[0].truth.size() && pairs.size() < 60; ++i) {
+    const int j = keyframes[0].truth[i];
+    if (j < 0 || j % 2 == 0) continue;
+    const auto it = std::find(keyframes[1].truth.begin(), keyframes[1].truth.end(), j);
+    if (it != keyframes[1].truth.end()) {
+      pairs.emplace_back(static_cast<int>(i), static_cast<int>(it - keyframes[1].truth.begin()));
+    }
+  }
+  ASSERT_EQ(pairs.size(), 60u);
+  map.Write([&](MapData& data) {
+    for (const auto& [i0, i1] : pairs) {
+      const int j = keyframes[0].truth[i0];
+      for (const auto& [keyframe, index] : {std::pair{keyframes[0].id, i0}, std::pair{keyframes[1].id, i1}}) {
+        MapPoint point;
+        point.p_in_world = scene.points()[j] + Eigen::Vector3d(0.0, 0.0, 0.01);
+        point.reference_keyframe = keyframe;
+        const MapPointId id = data.AddMapPoint(point);
+        data.AddObservation(keyframe, index, id);
+        data.UpdateDescriptor(id);
+        data.UpdateNormalAndDepth(id);
+      }
+    }
+  });
+  const std::size_t before = map.NumMapPoints();
+  LocalMapper mapper(map);
+  const int fused = mapper.FuseDuplicates(keyframes[1].id);
+  EXPECT_GE(fused, 57);
+  EXPECT_EQ(map.NumMapPoints(), before - fused);
+  EXPECT_EQ(map.Read([](const MapData& data) { return data.CheckInvariants(); }), "");
+  // Every fused pair now shares one point.
+  const int shared = map.Read([&](const MapData& data) {
+    int count = 0;
+    for (const auto& [i0, i1] : pairs) {
+      const MapPointId a = data.FindKeyframe(keyframes[0].id)->map_point_ids[i0];
+      count += a.IsValid() && a == data.FindKeyframe(keyframes[1].id)->map_point_ids[i1];
+    }
+    return count;
+  });
+  EXPECT_EQ(shared, fused);
+}
+
+TEST(LocalMapper, CullsRedundantKeyframesOneAtATime) {
+  Scene scene(3);
+  Map map;
+  const auto keyframes = BuildMap(scene, map, {0, 1, 2, 3, 4}, [](int) { return true; });
+  LocalMapper mapper(map);
+  // Every point is seen by all five: keyframe 1 has 4 other observers, so does 2 after 1 is
+  // gone (3 others: 0, 3, 4), but then 3 has only 2 others left.
+  EXPECT_EQ(mapper.CullRedundantKeyframes(keyframes[4].id), 2);
+  map.Read([&](const MapData& data) {
+    EXPECT_EQ(data.FindKeyframe(keyframes[1].id), nullptr);
+    EXPECT_EQ(data.FindKeyframe(keyframes[2].id), nullptr);
+    EXPECT_NE(data.FindKeyframe(keyframes[3].id), nullptr);
+    EXPECT_NE(data.FindKeyframe(keyframes[0].id), nullptr);
+    EXPECT_EQ(data.CheckInvariants(), "");
+    return 0;
+  });
+}
+
+TEST(LocalMapper, TrackingAndMappingGrowAnAccurateMap) {
+  Scene scene(5);
+  Map map;
+  const auto initial = BuildMap(scene, map, {0, 8}, [](int) { return true; });
+  std::vector<SceneKeyframe> keyframes = initial;
+  Tracker tracker(map);
+  std::vector<int> truth;
+  Frame start = scene.MakeFrame(8, &truth);
+  map.Read([&](const MapData& data) {
+    start.map_point_ids = data.FindKeyframe(initial[1].id)->map_point_ids;
+    return 0;
+  });
+  tracker.Start(start, initial[1].id);
+  LocalMapper mapper(map);
+  const KeyframePolicyOptions policy;
+  int since_last = 0;
+  double max_position_error = 0.0;
+  for (int t = 9; t <= 60; ++t) {
+    Frame frame = scene.MakeFrame(t, &truth);
+    const Rigid3 true_pose = *frame.cam_from_world;
+    frame.cam_from_world.reset();
+    const TrackingResult result = tracker.Track(frame);
+    ASSERT_EQ(result.state, TrackingState::kTracking) << "frame " << t;
+    max_position_error = std::max(
+        max_position_error,
+        (frame.cam_from_world->Inverse().translation - true_pose.Inverse().translation).norm());
+    ++since_last;
+    const int reference_tracked = map.Read([&](const MapData& data) {
+      return ReferenceTrackedPoints(data, tracker.reference_keyframe(), 2);
+    });
+    if (!DecideKeyframe(policy, {since_last, result.num_inliers, reference_tracked}).insert) {
+      continue;
+    }
+    const KeyframeId id = InsertKeyframe(map, frame, tracker.reference_keyframe());
+    keyframes.push_back({id, truth});
+    tracker.SetReferenceKeyframe(id);
+    const LocalMappingResult mapped = mapper.ProcessKeyframe(id);
+    EXPECT_TRUE(mapped.processed);
+    since_last = 0;
+  }
+  EXPECT_GE(keyframes.size(), 5u);
+  // The camera travels 3 m; the first two keyframes' points leave the view by then, so
+  // tracking to the end relies on the triangulated points.
+  EXPECT_LT(max_position_error, 0.05);
+  EXPECT_EQ(map.Read([](const MapData& data) { return data.CheckInvariants(); }), "");
+  std::vector<Eigen::Vector3d> positions;
+  const auto truth_of_points = TruthOfPoints(map, keyframes, &positions);
+  int consistent = 0;
+  std::vector<double> errors;
+  for (std::size_t k = 0; k < truth_of_points.size(); ++k) {
+    const auto& seen = truth_of_points[k];
+    if (seen.empty() || seen[0] < 0 ||
+        std::any_of(seen.begin(), seen.end(), [&](int j) { return j != seen[0]; })) {
+      continue;
+    }
+    ++consistent;
+    errors.push_back((positions[k] - scene.points()[seen[0]]).norm() / scene.points()[seen[0]].z());
+  }
+  EXPECT_GE(consistent, 0.98 * truth_of_points.size());
+  std::sort(errors.begin(), errors.end());
+  EXPECT_LT(errors[errors.size() / 2], 0.01);
+}
+
+}  // namespace
+}  // namespace arucoslam

@@ -1,0 +1,91 @@
+// Tracker: estimates the pose of each new frame against the Map (constant-velocity motion
+// model with projection search, reference-keyframe fallback, then the local map), synchronous.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "arucoslam/feature/orb_matcher.h"
+#include "arucoslam/map/frame.h"
+#include "arucoslam/map/map.h"
+#include "arucoslam/optim/pose_optimizer.h"
+
+namespace arucoslam {
+
+enum class TrackingState { kNotInitialized, kTracking, kLost };
+std::string TrackingStateName(TrackingState state);
+
+struct TrackerOptions {
+  // Motion model: the last frame's points projected with the predicted pose; radius
+  // base_radius_px x scale(level), so 15 px at level 0 (ORB-SLAM's monocular window).
+  ProjectionMatchOptions motion_search{15.0, 1, 100, 0.9, true, {}};
+  // Fewer matches than this: search again with twice the radius, then fall back.
+  int min_motion_matches = 20;
+  // Fallback: brute-force descriptor matching against the reference keyframe.
+  BruteForceMatchOptions reference_search{64, 0.75, true, true, {}};
+  int min_reference_matches = 15;
+  // Local map: keyframes observing the frame's matched points plus up to this many best
+  // covisible neighbours of each, at most max_local_keyframes in all.
+  int covisible_per_keyframe = 10;
+  int max_local_keyframes = 80;
+  // Projection search of local points: radius base x (2.5 when viewed nearly head-on, else
+  // 4) x scale(level), pixels.
+  ProjectionMatchOptions local_map_search{1.0, 1, 100, 0.8, false, {}};
+  // A point is searched only when its mean viewing direction and the current ray make an
+  // angle with cosine at least this (60 degrees).
+  double min_view_cos = 0.5;
+  // Inliers needed after the first pose optimisation and after the local map.
+  int min_pose_inliers = 10;
+  int min_local_map_inliers = 30;
+  PoseOptimizationOptions pose;
+
+  bool Check() const;
+};
+
+struct TrackingResult {
+  TrackingState state = TrackingState::kNotInitialized;
+  std::string method;  // "motion", "reference" or "" when no pose
+  int num_initial_matches = 0;
+  int num_initial_inliers = 0;
+  int num_local_map_matches = 0;  // matches added by the local-map search
+  int num_inliers = 0;            // final inliers
+};
+
+class Tracker {
+ public:
+  Tracker(Map& map, const TrackerOptions& options = {});
+
+  // After map initialisation (or relocalisation): `frame` has a pose and its matches;
+  // `reference` is the keyframe made from it. Tracking continues from there.
+  void Start(const Frame& frame, KeyframeId reference);
+  // The keyframe most recently inserted becomes the reference for the fallback search.
+  void SetReferenceKeyframe(KeyframeId reference) { reference_keyframe_ = reference; }
+  // Forgets the pose history (state kNotInitialized).
+  void Reset();
+
+  // Tracks `frame` (features with `undistorted` filled, camera set). On success fills
+  // frame.cam_from_world and frame.map_point_ids (outlier matches removed).
+  TrackingResult Track(Frame& frame);
+
+  TrackingState state() const { return state_; }
+  KeyframeId reference_keyframe() const { return reference_keyframe_; }
+  // cam_from_world(current) * world_from_cam(last) after the last successful frame.
+  const std::optional<Rigid3>& velocity() const { return velocity_; }
+
+ private:
+  bool TrackWithMotionModel(Frame& frame, TrackingResult& result);
+  bool TrackReferenceKeyframe(Frame& frame, TrackingResult& result);
+  bool TrackLocalMap(Frame& frame, TrackingResult& result);
+  // Pose-only optimisation over the frame's matches from `initial`; drops outlier matches
+  // and returns the number of inliers (0 when it failed).
+  int OptimizeFramePose(Frame& frame, const Rigid3& initial);
+
+  Map& map_;
+  TrackerOptions options_;
+  TrackingState state_ = TrackingState::kNotInitialized;
+  std::optional<Frame> last_frame_;
+  std::optional<Rigid3> velocity_;
+  KeyframeId reference_keyframe_;
+};
+
+}  // namespace arucoslam

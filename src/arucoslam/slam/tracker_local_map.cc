@@ -1,0 +1,113 @@
+// Tracker::TrackLocalMap: the local keyframes (those observing the frame's matches and their
+// best covisible neighbours), their points projected into the frame and matched, then the
+// final pose optimisation.
+#include <algorithm>
+#include <map>
+#include <set>
+#include <vector>
+
+#include "arucoslam/feature/feature_grid.h"
+#include "arucoslam/slam/projection_queries.h"
+#include "arucoslam/slam/tracker.h"
+
+namespace arucoslam {
+namespace {
+
+// Keyframes observing the frame's matched points, most votes first, then best covisible
+// neighbours of each; the first one is the frame's natural reference keyframe.
+std::vector<KeyframeId> LocalKeyframes(const MapData& data, const Frame& frame,
+                                       const TrackerOptions& options) {
+  std::map<KeyframeId, int> votes;
+  for (const MapPointId& id : frame.map_point_ids) {
+    if (const MapPoint* point = data.FindMapPoint(id)) {
+      for (const auto& [keyframe, index] : point->observations) ++votes[keyframe];
+    }
+  }
+  std::vector<std::pair<int, KeyframeId>> sorted;
+  for (const auto& [keyframe, count] : votes) sorted.emplace_back(-count, keyframe);
+  std::sort(sorted.begin(), sorted.end());
+  std::vector<KeyframeId> local;
+  std::set<KeyframeId> included;
+  for (const auto& entry : sorted) {
+    if (static_cast<int>(local.size()) >= options.max_local_keyframes) break;
+    local.push_back(entry.second);
+    included.insert(entry.second);
+  }
+  const std::size_t num_direct = local.size();
+  for (std::size_t k = 0; k < num_direct; ++k) {
+    for (const KeyframeId& neighbour :
+         data.covisibility().BestCovisible(local[k], options.covisible_per_keyframe)) {
+      if (static_cast<int>(local.size()) >= options.max_local_keyframes) return local;
+      if (included.insert(neighbour).second) local.push_back(neighbour);
+    }
+  }
+  return local;
+}
+
+// Projects the local points that the frame has not matched yet; returns the queries and
+// (through `visible`) every point predicted in view, matched ones included.
+ProjectionQueries LocalPointQueries(const MapData& data, const Frame& frame,
+                                    const std::vector<KeyframeId>& local,
+                                    const TrackerOptions& options,
+                                    std::vector<MapPointId>* visible) {
+  std::set<MapPointId> matched;
+  for (const MapPointId& id : frame.map_point_ids) {
+    if (id.IsValid()) {
+      matched.insert(id);
+      visible->push_back(id);
+    }
+  }
+  const Rigid3& cam_from_world = *frame.cam_from_world;
+  const Eigen::Vector3d center = cam_from_world.Inverse().translation;
+  std::set<MapPointId> seen;
+  ProjectionQueries set;
+  for (const KeyframeId& keyframe : local) {
+    for (const MapPointId& id : data.MapPointsOf(keyframe)) {
+      if (matched.count(id) != 0 || !seen.insert(id).second) continue;
+      const MapPoint& point = *data.FindMapPoint(id);
+      const std::optional<Eigen::Vector2d> pixel =
+          frame.camera.Project(cam_from_world * point.p_in_world);
+      if (!pixel || !frame.camera.InImage(*pixel)) continue;
+      const Eigen::Vector3d ray = point.p_in_world - center;
+      const double distance = ray.norm();
+      if (!point.InDistanceRange(distance)) continue;
+      const double view_cos = point.normal.dot(ray) / distance;
+      if (view_cos < options.min_view_cos) continue;
+      const int level = point.PredictLevel(distance, frame.features.pyramid);
+      set.Add(id, *pixel, level, point.descriptor, view_cos > 0.998 ? 2.5 : 4.0, -1.0f);
+      visible->push_back(id);
+    }
+  }
+  set.Finalize();
+  return set;
+}
+
+}  // namespace
+
+bool Tracker::TrackLocalMap(Frame& frame, TrackingResult& result) {
+  std::vector<MapPointId> visible;
+  ProjectionQueries set;
+  map_.Read([&](const MapData& data) {
+    const std::vector<KeyframeId> local = LocalKeyframes(data, frame, options_);
+    if (!local.empty()) reference_keyframe_ = local.front();
+    set = LocalPointQueries(data, frame, local, options_, &visible);
+  });
+  std::vector<bool> taken(frame.features.size(), false);
+  for (std::size_t i = 0; i < frame.map_point_ids.size(); ++i) {
+    taken[i] = frame.map_point_ids[i].IsValid();
+  }
+  const FeatureGrid grid(frame.features);
+  const std::vector<FeatureMatch> matches =
+      MatchByProjection(frame.features, grid, set.queries, taken, options_.local_map_search);
+  result.num_local_map_matches = set.AssignTo(matches, frame);
+  result.num_inliers = OptimizeFramePose(frame, *frame.cam_from_world);
+  map_.Write([&](MapData& data) {
+    for (const MapPointId& id : visible) data.IncreaseVisible(id);
+    for (const MapPointId& id : frame.map_point_ids) {
+      if (id.IsValid()) data.IncreaseFound(id);
+    }
+  });
+  return result.num_inliers >= options_.min_local_map_inliers;
+}
+
+}  // namespace arucoslam
