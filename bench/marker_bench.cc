@@ -26,10 +26,10 @@ CameraModel Camera(int width, int height) {
 // Four 0.2 m markers 1.5-3 m away, tilted, spread over the image.
 std::vector<SyntheticMarker> Markers() {
   std::vector<SyntheticMarker> markers;
-  const Eigen::Matrix3d facing =
-      Eigen::AngleAxisd(0.4, Eigen::Vector3d(0.6, 0.8, 0)) * Eigen::Vector3d(1, -1, -1).asDiagonal();
-  const Eigen::Vector3d positions[4] = {{-0.6, -0.3, 2.0}, {0.5, -0.3, 1.5}, {0.5, 0.4, 3.0},
-                                        {-0.5, 0.4, 2.5}};
+  const Eigen::Matrix3d facing = Eigen::AngleAxisd(0.4, Eigen::Vector3d(0.6, 0.8, 0)) *
+                                 Eigen::Vector3d(1, -1, -1).asDiagonal();
+  const Eigen::Vector3d positions[4] = {
+      {-0.6, -0.3, 2.0}, {0.5, -0.3, 1.5}, {0.5, 0.4, 3.0}, {-0.5, 0.4, 2.5}};
   for (int i = 0; i < 4; ++i) {
     SyntheticMarker marker;
     marker.id = 2 * i + 1;
@@ -40,7 +40,8 @@ std::vector<SyntheticMarker> Markers() {
 }
 
 void BM_Detect(benchmark::State& state) {
-  const CameraModel camera = Camera(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  const CameraModel camera =
+      Camera(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
   const cv::Mat image = RenderSyntheticView(camera, Markers(), {});
   const MarkerDetector detector;
   size_t found = 0;

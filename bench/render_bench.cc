@@ -67,7 +67,7 @@ void BM_RenderFrame(benchmark::State& state) {
   }
   state.counters["frames/s"] = benchmark::Counter(state.iterations(), benchmark::Counter::kIsRate);
 }
-BENCHMARK(BM_RenderFrame)->Arg(1)->Arg(2)->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_RenderFrame)->Arg(1)->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_RenderAndEncodePng(benchmark::State& state) {
   BenchWorld& bench = World();

@@ -55,8 +55,8 @@ std::optional<AlignmentResult> ComputeAlignment(const AssociatedTrajectories& pa
     source.push_back(pairs.est.poses[i].translation);
     target.push_back(pairs.gt.poses[i].translation);
   }
-  const AlignmentKind kind = options.mode == AlignmentMode::kSim3 ? AlignmentKind::kSimilarity
-                                                                 : AlignmentKind::kRigid;
+  const AlignmentKind kind =
+      options.mode == AlignmentMode::kSim3 ? AlignmentKind::kSimilarity : AlignmentKind::kRigid;
   const std::optional<Sim3> fit = UmeyamaAlignment(source, target, kind);
   if (!fit) return std::nullopt;
   result.gt_from_est = *fit;

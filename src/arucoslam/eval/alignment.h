@@ -29,7 +29,7 @@ struct AlignmentOptions {
 
 struct AlignmentResult {
   AlignmentMode mode = AlignmentMode::kNone;
-  Sim3 gt_from_est;          // identity for kNone; scale exactly 1 for kSe3
+  Sim3 gt_from_est;            // identity for kNone; scale exactly 1 for kSe3
   std::size_t num_fitted = 0;  // pairs the fit used
 };
 

@@ -20,8 +20,8 @@ AssociatedTrajectories HelixPairs(const Sim3& gt_from_est, int count) {
   return pairs;
 }
 
-const Sim3 kTruth(2.5, Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3)
-                                                                      .normalized())),
+const Sim3 kTruth(2.5,
+                  Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized())),
                   Eigen::Vector3d(4.0, -1.0, 0.5));
 
 TEST(Alignment, Sim3RecoversAKnownSimilarity) {
@@ -36,10 +36,8 @@ TEST(Alignment, Sim3RecoversAKnownSimilarity) {
   EXPECT_NEAR((result->gt_from_est.translation - kTruth.translation).norm(), 0.0, 1e-11);
   const Trajectory aligned = ApplyAlignment(result->gt_from_est, pairs.est);
   for (std::size_t i = 0; i < pairs.size(); ++i) {
-    EXPECT_NEAR((aligned.poses[i].translation - pairs.gt.poses[i].translation).norm(), 0.0,
-                1e-11);
-    EXPECT_NEAR(aligned.poses[i].rotation.angularDistance(pairs.gt.poses[i].rotation), 0.0,
-                1e-12);
+    EXPECT_NEAR((aligned.poses[i].translation - pairs.gt.poses[i].translation).norm(), 0.0, 1e-11);
+    EXPECT_NEAR(aligned.poses[i].rotation.angularDistance(pairs.gt.poses[i].rotation), 0.0, 1e-12);
   }
 }
 

@@ -37,8 +37,7 @@ AssociatedTrajectories AssociateByTime(const Trajectory& gt, const Trajectory& e
   const Trajectory& longer = est_longer ? est : gt;
   for (std::size_t i = 0; i < shorter.size(); ++i) {
     const std::size_t j = ClosestIndex(longer.timestamps, shorter.timestamps[i]);
-    if (!(std::abs(longer.timestamps[j] - shorter.timestamps[i]) <=
-          options.max_time_difference)) {
+    if (!(std::abs(longer.timestamps[j] - shorter.timestamps[i]) <= options.max_time_difference)) {
       continue;
     }
     const std::size_t gt_index = est_longer ? i : j;

@@ -7,8 +7,8 @@ namespace {
 
 Trajectory Stamps(const std::vector<double>& stamps) {
   Trajectory trajectory;
-  for (double t : stamps) trajectory.Add(t, Rigid3(Eigen::Quaterniond::Identity(),
-                                                   Eigen::Vector3d(t, 0.0, 0.0)));
+  for (double t : stamps)
+    trajectory.Add(t, Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(t, 0.0, 0.0)));
   return trajectory;
 }
 

@@ -15,13 +15,13 @@ struct CompletenessOptions {
 };
 
 struct Completeness {
-  double gt_duration = 0.0;       // s, last minus first ground-truth stamp
-  double covered_duration = 0.0;  // s, of the ground-truth span covered by the estimate
-  double covered_fraction = 0.0;  // covered_duration / gt_duration (1 for a zero span)
-  double longest_gap = 0.0;       // s
+  double gt_duration = 0.0;        // s, last minus first ground-truth stamp
+  double covered_duration = 0.0;   // s, of the ground-truth span covered by the estimate
+  double covered_fraction = 0.0;   // covered_duration / gt_duration (1 for a zero span)
+  double longest_gap = 0.0;        // s
   double longest_gap_start = 0.0;  // s, stamp where the longest gap begins
-  int num_gaps = 0;               // gaps longer than the threshold, ends included
-  double max_gap_used = 0.0;      // s, the threshold applied
+  int num_gaps = 0;                // gaps longer than the threshold, ends included
+  double max_gap_used = 0.0;       // s, the threshold applied
 };
 
 // Both trajectories with non-decreasing stamps; an empty estimate covers nothing.

@@ -10,8 +10,7 @@
 namespace arucoslam {
 
 bool EvaluationOptions::Check() const {
-  if (!association.Check() || !alignment.Check() || !per_axis.Check() ||
-      !completeness.Check()) {
+  if (!association.Check() || !alignment.Check() || !per_axis.Check() || !completeness.Check()) {
     return false;
   }
   for (const RelativeErrorOptions& r : relative) {
@@ -23,8 +22,7 @@ bool EvaluationOptions::Check() const {
 namespace {
 
 AssociatedTrajectories Associate(const Trajectory& gt, const Trajectory& est,
-                                 const std::string& est_source,
-                                 const EvaluationOptions& options) {
+                                 const std::string& est_source, const EvaluationOptions& options) {
   if (options.associate_by_index) {
     if (gt.size() != est.size()) {
       throw InputError(est_source, fmt::format("{} poses, ground truth has {} (pairing by "
@@ -35,12 +33,11 @@ AssociatedTrajectories Associate(const Trajectory& gt, const Trajectory& est,
   }
   AssociatedTrajectories pairs = AssociateByTime(gt, est, options.association);
   if (pairs.size() == 0) {
-    throw InputError(est_source,
-                     fmt::format("no pose within {} s of a ground-truth pose (estimate "
-                                 "{:.3f}..{:.3f} s, ground truth {:.3f}..{:.3f} s)",
-                                 options.association.max_time_difference,
-                                 est.timestamps.front(), est.timestamps.back(),
-                                 gt.timestamps.front(), gt.timestamps.back()));
+    throw InputError(est_source, fmt::format("no pose within {} s of a ground-truth pose (estimate "
+                                             "{:.3f}..{:.3f} s, ground truth {:.3f}..{:.3f} s)",
+                                             options.association.max_time_difference,
+                                             est.timestamps.front(), est.timestamps.back(),
+                                             gt.timestamps.front(), gt.timestamps.back()));
   }
   return pairs;
 }
@@ -48,8 +45,7 @@ AssociatedTrajectories Associate(const Trajectory& gt, const Trajectory& est,
 }  // namespace
 
 TrajectoryEvaluation EvaluateTrajectory(const Trajectory& gt, const Trajectory& est,
-                                        const std::string& label,
-                                        const std::string& est_source,
+                                        const std::string& label, const std::string& est_source,
                                         const EvaluationOptions& options) {
   if (!options.Check()) throw std::invalid_argument("EvaluationOptions: invalid");
   if (gt.empty() || est.empty()) throw InputError(est_source, "empty trajectory");
@@ -69,8 +65,9 @@ TrajectoryEvaluation EvaluateTrajectory(const Trajectory& gt, const Trajectory& 
   sim3_options.mode = AlignmentMode::kSim3;
   const std::optional<AlignmentResult> sim3 = ComputeAlignment(result.pairs, sim3_options);
   if (!alignment || !sim3) {
-    throw InputError(est_source, "cannot align: fewer than 3 pairs in the alignment "
-                                 "selection or all positions coincide");
+    throw InputError(est_source,
+                     "cannot align: fewer than 3 pairs in the alignment "
+                     "selection or all positions coincide");
   }
   result.alignment = *alignment;
   result.sim3_scale = sim3->gt_from_est.scale;
@@ -87,8 +84,8 @@ TrajectoryEvaluation EvaluateTrajectory(const Trajectory& gt, const Trajectory& 
     const IndexPairs index_pairs = RelativeIndexPairs(result.aligned_est, relative);
     RelativeErrorResult r;
     r.options = relative;
-    r.translation = ComputeErrorStatistics(RelativePoseErrors(
-        gt_pairs, result.aligned_est, index_pairs, PoseRelation::kTranslation));
+    r.translation = ComputeErrorStatistics(
+        RelativePoseErrors(gt_pairs, result.aligned_est, index_pairs, PoseRelation::kTranslation));
     r.rotation_deg = ComputeErrorStatistics(RelativePoseErrors(
         gt_pairs, result.aligned_est, index_pairs, PoseRelation::kRotationAngleDeg));
     result.relative.push_back(r);

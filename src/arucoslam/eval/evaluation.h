@@ -17,11 +17,11 @@
 namespace arucoslam {
 
 struct EvaluationOptions {
-  AssociationOptions association;   // max time difference 0.01 s (evo's default)
-  AlignmentOptions alignment;       // none by default: a world-anchored system's own frame
+  AssociationOptions association;  // max time difference 0.01 s (evo's default)
+  AlignmentOptions alignment;      // none by default: a world-anchored system's own frame
   // RPE deltas to report; default: 1 frame (consecutive pairs).
   std::vector<RelativeErrorOptions> relative = {RelativeErrorOptions{}};
-  PerAxisErrorOptions per_axis;     // no timestamps by default
+  PerAxisErrorOptions per_axis;      // no timestamps by default
   CompletenessOptions completeness;  // gap threshold automatic
   // Pair poses by index instead of time (both files without time, e.g. KITTI).
   bool associate_by_index = false;
@@ -59,8 +59,7 @@ struct TrajectoryEvaluation {
 // Throws InputError (source `est_source`) when no pose pairs in time (no overlap), fewer
 // than 3 pairs, or the alignment is degenerate.
 TrajectoryEvaluation EvaluateTrajectory(const Trajectory& gt, const Trajectory& est,
-                                        const std::string& label,
-                                        const std::string& est_source,
+                                        const std::string& label, const std::string& est_source,
                                         const EvaluationOptions& options);
 
 }  // namespace arucoslam

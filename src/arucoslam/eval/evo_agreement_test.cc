@@ -1,12 +1,12 @@
 // Reproduces evo v1.36.5's numbers on its own test data (../shared/data/evo_testdata):
 // every case of expected_metrics_evo_v1.36.5.json to a relative 1e-6.
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <nlohmann/json.hpp>
 
 #include "arucoslam/eval/alignment.h"
 #include "arucoslam/eval/association.h"
@@ -78,12 +78,12 @@ TEST(EvoAgreement, EveryExpectedMetric) {
   std::map<std::string, AssociatedTrajectories> loaded;
   for (const nlohmann::json& entry : expected) {
     const std::string name = entry["case"];
-    const std::string what = name + " " + entry["metric"].get<std::string>() + " " +
-                             entry["relation"].get<std::string>() + " align " +
-                             entry["align"].get<std::string>() +
-                             (entry.contains("delta") ? " delta " + entry["delta"].dump() +
-                                                            entry["delta_unit"].get<std::string>()
-                                                      : "");
+    const std::string what =
+        name + " " + entry["metric"].get<std::string>() + " " +
+        entry["relation"].get<std::string>() + " align " + entry["align"].get<std::string>() +
+        (entry.contains("delta")
+             ? " delta " + entry["delta"].dump() + entry["delta_unit"].get<std::string>()
+             : "");
     SCOPED_TRACE(what);
     ASSERT_TRUE(Cases().count(name)) << name;
     if (!loaded.count(name)) loaded.emplace(name, LoadPairs(Cases().at(name)));

@@ -3,7 +3,6 @@
 #pragma once
 
 #include <Eigen/Core>
-
 #include <vector>
 
 #include "arucoslam/geometry/sim3.h"

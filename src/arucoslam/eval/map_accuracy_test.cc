@@ -19,17 +19,16 @@ SurfacePrimitive Box(const Rigid3& pose, const Eigen::Vector3d& size) {
 
 TEST(MapAccuracy, BoxDistanceOutsideInsideAndRotated) {
   const SurfacePrimitive box = Box(Rigid3(), Eigen::Vector3d(2.0, 4.0, 6.0));
-  EXPECT_NEAR(DistanceToSurface(box, Eigen::Vector3d(1.5, 0, 0)), 0.5, 1e-15);   // face
+  EXPECT_NEAR(DistanceToSurface(box, Eigen::Vector3d(1.5, 0, 0)), 0.5, 1e-15);           // face
   EXPECT_NEAR(DistanceToSurface(box, Eigen::Vector3d(2, 3, 0)), std::sqrt(2.0), 1e-15);  // edge
   EXPECT_NEAR(DistanceToSurface(box, Eigen::Vector3d(2, 3, 4)), std::sqrt(3.0), 1e-15);  // corner
-  EXPECT_NEAR(DistanceToSurface(box, Eigen::Vector3d(0.2, 0, 0)), 0.8, 1e-15);   // inside
+  EXPECT_NEAR(DistanceToSurface(box, Eigen::Vector3d(0.2, 0, 0)), 0.8, 1e-15);           // inside
   EXPECT_NEAR(DistanceToSurface(box, Eigen::Vector3d(0, 1.9, 0)), 0.1, 1e-15);
   // Turned 90 degrees about z and moved: its 4 m side now lies along x.
-  const SurfacePrimitive turned =
-      Box(Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(std::numbers::pi / 2,
-                                                      Eigen::Vector3d::UnitZ())),
-                 Eigen::Vector3d(10, 0, 0)),
-          Eigen::Vector3d(2.0, 4.0, 6.0));
+  const SurfacePrimitive turned = Box(
+      Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::UnitZ())),
+             Eigen::Vector3d(10, 0, 0)),
+      Eigen::Vector3d(2.0, 4.0, 6.0));
   EXPECT_NEAR(DistanceToSurface(turned, Eigen::Vector3d(12.5, 0, 0)), 0.5, 1e-12);
   EXPECT_NEAR(DistanceToSurface(turned, Eigen::Vector3d(10, 1.25, 0)), 0.25, 1e-12);
 }
@@ -48,15 +47,14 @@ TEST(MapAccuracy, PlaneAndCylinderDistances) {
   cylinder.radius = 1.0;
   cylinder.length = 4.0;
   cylinder.world_from_shape.translation = Eigen::Vector3d(0, 0, 2);  // standing on z = 0
-  EXPECT_NEAR(DistanceToSurface(cylinder, Eigen::Vector3d(3, 0, 1)), 2.0, 1e-15);   // side
-  EXPECT_NEAR(DistanceToSurface(cylinder, Eigen::Vector3d(0, 0, 5)), 1.0, 1e-15);   // cap
-  EXPECT_NEAR(DistanceToSurface(cylinder, Eigen::Vector3d(4, 0, 8)), 5.0, 1e-15);   // rim
-  EXPECT_NEAR(DistanceToSurface(cylinder, Eigen::Vector3d(0.7, 0, 2)), 0.3, 1e-15); // inside
-  EXPECT_NEAR(DistanceToSurface(cylinder, Eigen::Vector3d(0, 0, 0.1)), 0.1, 1e-15); // by a cap
+  EXPECT_NEAR(DistanceToSurface(cylinder, Eigen::Vector3d(3, 0, 1)), 2.0, 1e-15);    // side
+  EXPECT_NEAR(DistanceToSurface(cylinder, Eigen::Vector3d(0, 0, 5)), 1.0, 1e-15);    // cap
+  EXPECT_NEAR(DistanceToSurface(cylinder, Eigen::Vector3d(4, 0, 8)), 5.0, 1e-15);    // rim
+  EXPECT_NEAR(DistanceToSurface(cylinder, Eigen::Vector3d(0.7, 0, 2)), 0.3, 1e-15);  // inside
+  EXPECT_NEAR(DistanceToSurface(cylinder, Eigen::Vector3d(0, 0, 0.1)), 0.1, 1e-15);  // by a cap
   EXPECT_EQ(DistanceToNearestSurface({}, Eigen::Vector3d::Zero()),
             std::numeric_limits<double>::infinity());
-  EXPECT_NEAR(DistanceToNearestSurface({plane, cylinder}, Eigen::Vector3d(3, 0, 1)), 1.0,
-              1e-15);
+  EXPECT_NEAR(DistanceToNearestSurface({plane, cylinder}, Eigen::Vector3d(3, 0, 1)), 1.0, 1e-15);
 }
 
 TEST(MapAccuracy, StatisticsAfterTheTrajectoryAlignment) {

@@ -3,7 +3,6 @@
 #pragma once
 
 #include <Eigen/Core>
-
 #include <vector>
 
 #include "arucoslam/io/trajectory_io.h"

@@ -21,8 +21,8 @@ TEST(PerAxisError, StatisticsAndSamplesAtChosenTimes) {
   EXPECT_EQ(result.count, 5u);
   EXPECT_NEAR(result.mean_abs.x(), 0.1, 1e-15);
   EXPECT_NEAR(result.std_abs.x(), 0.0, 1e-15);
-  EXPECT_NEAR(result.mean_abs.y(), 0.04, 1e-15);                  // mean of 0, .02 .. .08
-  EXPECT_NEAR(result.std_abs.y(), std::sqrt(0.0008), 1e-15);      // population std
+  EXPECT_NEAR(result.mean_abs.y(), 0.04, 1e-15);              // mean of 0, .02 .. .08
+  EXPECT_NEAR(result.std_abs.y(), std::sqrt(0.0008), 1e-15);  // population std
   EXPECT_NEAR(result.max_abs.y(), 0.08, 1e-15);
   EXPECT_EQ(result.mean_abs.z(), 0.0);
   ASSERT_EQ(result.samples.size(), 2u);

@@ -37,8 +37,7 @@ double ParseNumber(const std::string& token, int line_number, const std::string&
     if (used == token.size() && std::isfinite(value)) return value;
   } catch (const std::logic_error&) {
   }
-  throw InputError(source, fmt::format("line {}: '{}' is not a finite number", line_number,
-                                       token));
+  throw InputError(source, fmt::format("line {}: '{}' is not a finite number", line_number, token));
 }
 
 // Reads the header up to "end_header"; `line_number` ends on that line.
@@ -61,8 +60,8 @@ std::vector<PlyElement> ParseHeader(std::istream& stream, int& line_number,
     }
     if (t[0] == "format") {
       if (t.size() < 2 || t[1] != "ascii") {
-        throw InputError(source, fmt::format("line {}: only 'format ascii' is supported",
-                                             line_number));
+        throw InputError(source,
+                         fmt::format("line {}: only 'format ascii' is supported", line_number));
       }
       ascii = true;
     } else if (t[0] == "element" && t.size() == 3) {
@@ -77,8 +76,8 @@ std::vector<PlyElement> ParseHeader(std::istream& stream, int& line_number,
                ((t.size() == 3 && t[1] != "list") || (t.size() == 5 && t[1] == "list"))) {
       elements.back().properties.push_back({t.back(), t[1] == "list"});
     } else {
-      throw InputError(source, fmt::format("line {}: cannot read header line '{}'",
-                                           line_number, line));
+      throw InputError(source,
+                       fmt::format("line {}: cannot read header line '{}'", line_number, line));
     }
   }
   throw InputError(source, "no 'end_header' line");
@@ -112,8 +111,8 @@ std::vector<Eigen::Vector3d> ParsePlyPoints(const std::string& text, const std::
     }
     for (long long row = 0; row < element.count; ++row) {
       if (!std::getline(stream, line)) {
-        throw InputError(source, fmt::format("element {} ends after {} of {} lines",
-                                             element.name, row, element.count));
+        throw InputError(source, fmt::format("element {} ends after {} of {} lines", element.name,
+                                             row, element.count));
       }
       ++line_number;
       if (!is_vertex) continue;
@@ -127,8 +126,8 @@ std::vector<Eigen::Vector3d> ParsePlyPoints(const std::string& text, const std::
         values.push_back(value);
       }
       if (values.size() != element.properties.size() || token != t.size()) {
-        throw InputError(source, fmt::format("line {}: expected {} vertex properties",
-                                             line_number, element.properties.size()));
+        throw InputError(source, fmt::format("line {}: expected {} vertex properties", line_number,
+                                             element.properties.size()));
       }
       points.emplace_back(values[xyz[0]], values[xyz[1]], values[xyz[2]]);
     }

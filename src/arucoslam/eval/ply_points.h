@@ -3,7 +3,6 @@
 #pragma once
 
 #include <Eigen/Core>
-
 #include <filesystem>
 #include <string>
 #include <vector>

@@ -47,8 +47,8 @@ IndexPairs AllPairsByAccumulation(const std::vector<double>& cumulative, double 
   IndexPairs pairs;
   for (std::size_t i = 0; i + 1 < cumulative.size(); ++i) {
     const double target = cumulative[i] + delta;
-    auto it = std::lower_bound(cumulative.begin() + static_cast<long>(i) + 1, cumulative.end(),
-                               target);
+    auto it =
+        std::lower_bound(cumulative.begin() + static_cast<long>(i) + 1, cumulative.end(), target);
     std::size_t best = static_cast<std::size_t>(it - cumulative.begin());
     if (best == cumulative.size()) --best;
     if (best > i + 1) {
@@ -56,10 +56,10 @@ IndexPairs AllPairsByAccumulation(const std::vector<double>& cumulative, double 
       const double at = cumulative[best] - cumulative[i] - delta;
       if (it == cumulative.end() || std::abs(below) <= std::abs(at)) {
         // First index of the run of equal values below.
-        best = static_cast<std::size_t>(
-            std::lower_bound(cumulative.begin() + static_cast<long>(i) + 1,
-                             cumulative.end(), cumulative[best - 1]) -
-            cumulative.begin());
+        best =
+            static_cast<std::size_t>(std::lower_bound(cumulative.begin() + static_cast<long>(i) + 1,
+                                                      cumulative.end(), cumulative[best - 1]) -
+                                     cumulative.begin());
       }
     }
     if (std::abs(cumulative[best] - cumulative[i] - delta) <= tolerance) {

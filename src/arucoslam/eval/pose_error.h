@@ -28,9 +28,9 @@ enum class DeltaUnit { kFrames, kSeconds, kMeters };
 std::string DeltaUnitName(DeltaUnit unit);  // "frames", "s", "m"
 
 struct RelativeErrorOptions {
-  double delta = 1.0;            // in `unit` (frames: a positive integer)
+  double delta = 1.0;  // in `unit` (frames: a positive integer)
   DeltaUnit unit = DeltaUnit::kFrames;
-  bool all_pairs = false;        // every pair at distance delta instead of consecutive ones
+  bool all_pairs = false;           // every pair at distance delta instead of consecutive ones
   double relative_tolerance = 0.1;  // all_pairs with metres/seconds: accept |d - delta| <=
                                     // tolerance * delta
 

@@ -12,9 +12,9 @@ namespace {
 Trajectory Line(int count) {
   Trajectory trajectory;
   for (int i = 0; i < count; ++i) {
-    trajectory.Add(0.1 * i, Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(
-                                       0.01 * i, Eigen::Vector3d::UnitZ())),
-                                   Eigen::Vector3d(0.1 * i, 0.0, 0.0)));
+    trajectory.Add(0.1 * i,
+                   Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(0.01 * i, Eigen::Vector3d::UnitZ())),
+                          Eigen::Vector3d(0.1 * i, 0.0, 0.0)));
   }
   return trajectory;
 }
@@ -22,8 +22,8 @@ Trajectory Line(int count) {
 TEST(PoseError, AbsoluteErrorOfAKnownOffset) {
   const Trajectory gt = Line(10);
   Trajectory est = gt;
-  const Eigen::Quaterniond tilt(Eigen::AngleAxisd(2.0 * std::numbers::pi / 180.0,
-                                                  Eigen::Vector3d::UnitX()));
+  const Eigen::Quaterniond tilt(
+      Eigen::AngleAxisd(2.0 * std::numbers::pi / 180.0, Eigen::Vector3d::UnitX()));
   for (Rigid3& pose : est.poses) {
     pose.translation += Eigen::Vector3d(0.03, -0.04, 0.0);  // 5 cm
     pose.rotation = pose.rotation * tilt;                   // 2 degrees
@@ -49,9 +49,9 @@ TEST(PoseError, AbsoluteErrorOfAKnownOffset) {
 TEST(PoseError, RelativeErrorIgnoresAGlobalTransformAndSeesDrift) {
   const Trajectory gt = Line(21);
   Trajectory moved = gt;
-  const Rigid3 world_change(Eigen::Quaterniond(Eigen::AngleAxisd(1.0, Eigen::Vector3d(1, 1, 0)
-                                                                          .normalized())),
-                            Eigen::Vector3d(5, 6, 7));
+  const Rigid3 world_change(
+      Eigen::Quaterniond(Eigen::AngleAxisd(1.0, Eigen::Vector3d(1, 1, 0).normalized())),
+      Eigen::Vector3d(5, 6, 7));
   for (Rigid3& pose : moved.poses) pose = world_change * pose;
   const IndexPairs pairs = RelativeIndexPairs(moved, RelativeErrorOptions{});
   ASSERT_EQ(pairs.size(), 20u);

@@ -1,9 +1,9 @@
 #include "arucoslam/eval/report.h"
 
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <nlohmann/json.hpp>
 
 namespace arucoslam {
 namespace {
@@ -22,13 +22,12 @@ std::vector<Row> StatisticRows(const std::vector<TrajectoryEvaluation>& evaluati
   add("poses est / gt / paired", [](const TrajectoryEvaluation& e) {
     return fmt::format("{} / {} / {}", e.num_est_poses, e.num_gt_poses, e.pairs.size());
   });
-  add("alignment", [](const TrajectoryEvaluation& e) {
-    return AlignmentModeName(e.alignment.mode);
-  });
+  add("alignment",
+      [](const TrajectoryEvaluation& e) { return AlignmentModeName(e.alignment.mode); });
   const std::pair<const char*, double ErrorStatistics::*> fields[] = {
-      {"rmse", &ErrorStatistics::rmse}, {"mean", &ErrorStatistics::mean},
+      {"rmse", &ErrorStatistics::rmse},     {"mean", &ErrorStatistics::mean},
       {"median", &ErrorStatistics::median}, {"std", &ErrorStatistics::std},
-      {"min", &ErrorStatistics::min}, {"max", &ErrorStatistics::max}};
+      {"min", &ErrorStatistics::min},       {"max", &ErrorStatistics::max}};
   for (const auto& [name, field] : fields) {
     add(fmt::format("APE translation {} [m]", name),
         [field](const TrajectoryEvaluation& e) { return Fixed(e.ape_translation.*field, 4); });
@@ -40,12 +39,10 @@ std::vector<Row> StatisticRows(const std::vector<TrajectoryEvaluation>& evaluati
   for (std::size_t k = 0; k < evaluations.front().relative.size(); ++k) {
     const RelativeErrorOptions& o = evaluations.front().relative[k].options;
     const std::string delta = fmt::format("{:g} {}", o.delta, DeltaUnitName(o.unit));
-    add(fmt::format("RPE {} translation rmse [m]", delta), [k](const TrajectoryEvaluation& e) {
-      return Fixed(e.relative[k].translation.rmse, 4);
-    });
-    add(fmt::format("RPE {} rotation rmse [deg]", delta), [k](const TrajectoryEvaluation& e) {
-      return Fixed(e.relative[k].rotation_deg.rmse, 3);
-    });
+    add(fmt::format("RPE {} translation rmse [m]", delta),
+        [k](const TrajectoryEvaluation& e) { return Fixed(e.relative[k].translation.rmse, 4); });
+    add(fmt::format("RPE {} rotation rmse [deg]", delta),
+        [k](const TrajectoryEvaluation& e) { return Fixed(e.relative[k].rotation_deg.rmse, 3); });
   }
   const char* axes[] = {"x", "y", "z"};
   for (int a = 0; a < 3; ++a) {

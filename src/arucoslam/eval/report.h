@@ -18,12 +18,13 @@ std::string FormatEvaluationTable(const std::vector<TrajectoryEvaluation>& evalu
 // "per_axis": {...}, "scale": {...}, "completeness": {...}, "tracking"?, "map"?}]}.
 // Statistics objects hold count, rmse, mean, median, std, min, max, sse.
 std::string FormatResultsJson(const std::vector<TrajectoryEvaluation>& evaluations,
-                              const std::vector<std::string>& est_files,
-                              const std::string& gt_file, const EvaluationOptions& options);
+                              const std::vector<std::string>& est_files, const std::string& gt_file,
+                              const EvaluationOptions& options);
 
-// The plots as (file name, SVG text): trajectory_top_down.svg (x-y of the ground truth and
-// every aligned estimate), ape_over_time.svg, per_axis_error.svg (|dx|, |dy|, |dz| over
-// time, one panel per axis).
+// The plots as (file name, SVG text): trajectory_top_down.svg (the ground truth and every
+// aligned estimate in the plane of the two axes along which the ground truth spreads most:
+// x-y in a z-up world), ape_over_time.svg, per_axis_error.svg (|dx|, |dy|, |dz| over time,
+// one panel per axis, samples of --at marked). Lines break where tracking left a gap.
 std::vector<std::pair<std::string, std::string>> MakeEvaluationPlots(
     const Trajectory& gt, const std::vector<TrajectoryEvaluation>& evaluations);
 

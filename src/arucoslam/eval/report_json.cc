@@ -48,35 +48,41 @@ json EvaluationJson(const TrajectoryEvaluation& e, const std::string& file) {
   json out = {
       {"label", e.label},
       {"file", file},
-      {"poses", {{"estimate", e.num_est_poses}, {"ground_truth", e.num_gt_poses},
-                 {"pairs", e.pairs.size()}}},
+      {"poses",
+       {{"estimate", e.num_est_poses},
+        {"ground_truth", e.num_gt_poses},
+        {"pairs", e.pairs.size()}}},
       {"alignment",
        {{"mode", AlignmentModeName(e.alignment.mode)},
         {"pairs_fitted", e.alignment.num_fitted},
         {"scale", t.scale},
-        {"rotation_xyzw", json::array({t.rotation.x(), t.rotation.y(), t.rotation.z(),
-                                       t.rotation.w()})},
+        {"rotation_xyzw",
+         json::array({t.rotation.x(), t.rotation.y(), t.rotation.z(), t.rotation.w()})},
         {"translation", VectorJson(t.translation)}}},
-      {"ape", {{"translation_m", StatisticsJson(e.ape_translation)},
-               {"rotation_deg", StatisticsJson(e.ape_rotation_deg)}}},
+      {"ape",
+       {{"translation_m", StatisticsJson(e.ape_translation)},
+        {"rotation_deg", StatisticsJson(e.ape_rotation_deg)}}},
       {"rpe", rpe},
       {"per_axis", PerAxisJson(e.per_axis)},
       {"scale", {{"sim3_scale", e.sim3_scale}, {"scale_error", e.scale_error}}},
-      {"completeness", {{"covered_fraction", c.covered_fraction},
-                        {"covered_s", c.covered_duration},
-                        {"ground_truth_s", c.gt_duration},
-                        {"longest_gap_s", c.longest_gap},
-                        {"longest_gap_start_s", c.longest_gap_start},
-                        {"gaps", c.num_gaps},
-                        {"gap_threshold_s", c.max_gap_used}}},
+      {"completeness",
+       {{"covered_fraction", c.covered_fraction},
+        {"covered_s", c.covered_duration},
+        {"ground_truth_s", c.gt_duration},
+        {"longest_gap_s", c.longest_gap},
+        {"longest_gap_start_s", c.longest_gap_start},
+        {"gaps", c.num_gaps},
+        {"gap_threshold_s", c.max_gap_used}}},
   };
   if (e.tracking) {
     out["tracking"] = {{"losses", e.tracking->losses},
                        {"relocalisations", e.tracking->relocalisations}};
   }
   if (e.map) {
-    out["map"] = {{"points", e.map->num_points},         {"median_m", e.map->median},
-                  {"percentile_90_m", e.map->percentile_90}, {"mean_m", e.map->mean},
+    out["map"] = {{"points", e.map->num_points},
+                  {"median_m", e.map->median},
+                  {"percentile_90_m", e.map->percentile_90},
+                  {"mean_m", e.map->mean},
                   {"fraction_within", e.map->fraction_within},
                   {"within_m", e.map->inlier_distance}};
   }
@@ -86,8 +92,8 @@ json EvaluationJson(const TrajectoryEvaluation& e, const std::string& file) {
 }  // namespace
 
 std::string FormatResultsJson(const std::vector<TrajectoryEvaluation>& evaluations,
-                              const std::vector<std::string>& est_files,
-                              const std::string& gt_file, const EvaluationOptions& options) {
+                              const std::vector<std::string>& est_files, const std::string& gt_file,
+                              const EvaluationOptions& options) {
   json estimates = json::array();
   for (std::size_t i = 0; i < evaluations.size(); ++i) {
     estimates.push_back(EvaluationJson(evaluations[i], i < est_files.size() ? est_files[i] : ""));

@@ -34,14 +34,34 @@ std::string AlignmentSuffix(const std::vector<TrajectoryEvaluation>& evaluations
   return fmt::format("alignment: {}", AlignmentModeName(evaluations.front().alignment.mode));
 }
 
+// The two world axes along which the ground truth spreads most: x-y for a z-up world,
+// x-z for a camera-frame world such as KITTI's (y down).
+std::pair<int, int> ViewAxes(const Trajectory& gt) {
+  Eigen::Vector3d low = gt.poses.front().translation;
+  Eigen::Vector3d high = low;
+  for (const Rigid3& pose : gt.poses) {
+    low = low.cwiseMin(pose.translation);
+    high = high.cwiseMax(pose.translation);
+  }
+  Eigen::Index flattest = 2;
+  (high - low).minCoeff(&flattest);
+  if (flattest == 0) return {1, 2};
+  if (flattest == 1) return {0, 2};
+  return {0, 1};
+}
+
 SvgPlot TopDownPlot(const Trajectory& gt, const std::vector<TrajectoryEvaluation>& evaluations) {
-  SvgPlot plot({fmt::format("Trajectory, top-down view ({})", AlignmentSuffix(evaluations)),
-                "x [m]", "y [m]", 960, 760, true, false});
+  const auto [u, v] = ViewAxes(gt);
+  const char* names[] = {"x", "y", "z"};
+  SvgPlot plot({fmt::format("Trajectory, view from above ({}-{} plane, {})", names[u], names[v],
+                            AlignmentSuffix(evaluations)),
+                fmt::format("{} [m]", names[u]), fmt::format("{} [m]", names[v]), 960, 760, true,
+                false});
   std::vector<double> gx;
   std::vector<double> gy;
   for (const Rigid3& pose : gt.poses) {
-    gx.push_back(pose.translation.x());
-    gy.push_back(pose.translation.y());
+    gx.push_back(pose.translation[u]);
+    gy.push_back(pose.translation[v]);
   }
   plot.AddLine(gx, gy, "ground truth", kGroundTruthColor, 2.6, true);
   for (std::size_t k = 0; k < evaluations.size(); ++k) {
@@ -52,7 +72,7 @@ SvgPlot TopDownPlot(const Trajectory& gt, const std::vector<TrajectoryEvaluation
         e,
         [&](std::size_t i) {
           const Eigen::Vector3d& p = e.aligned_est.poses[i].translation;
-          return std::pair<double, double>(p.x(), p.y());
+          return std::pair<double, double>(p[u], p[v]);
         },
         x, y, 0.0, false);
     plot.AddLine(x, y, e.label, SvgPlot::PaletteColor(k), 1.8);
@@ -64,19 +84,16 @@ SvgPlot TopDownPlot(const Trajectory& gt, const std::vector<TrajectoryEvaluation
 }
 
 SvgPlot ApePlot(const Trajectory& gt, const std::vector<TrajectoryEvaluation>& evaluations) {
-  SvgPlot plot({fmt::format("Absolute position error over time ({})",
-                            AlignmentSuffix(evaluations)),
-                "time since the first ground-truth pose [s]", "position error [m]", 960, 520,
-                false, true});
+  SvgPlot plot({fmt::format("Absolute position error over time ({})", AlignmentSuffix(evaluations)),
+                "time since the first ground-truth pose [s]", "position error [m]", 960, 520, false,
+                true});
   for (std::size_t k = 0; k < evaluations.size(); ++k) {
     const TrajectoryEvaluation& e = evaluations[k];
     std::vector<double> x;
     std::vector<double> y;
     CollectWithGaps(
         e,
-        [&](std::size_t i) {
-          return std::pair<double, double>(0.0, e.ape_translation_errors[i]);
-        },
+        [&](std::size_t i) { return std::pair<double, double>(0.0, e.ape_translation_errors[i]); },
         x, y, gt.timestamps.front(), true);
     plot.AddLine(x, y, fmt::format("{} (rmse {:.3f} m)", e.label, e.ape_translation.rmse),
                  SvgPlot::PaletteColor(k), 1.6);
@@ -89,10 +106,10 @@ std::vector<SvgPlot> PerAxisPlots(const Trajectory& gt,
   std::vector<SvgPlot> plots;
   const char* axes[] = {"x", "y", "z"};
   for (int a = 0; a < 3; ++a) {
-    SvgPlot plot({fmt::format("Per-axis absolute error |d{}| ({})", axes[a],
-                              AlignmentSuffix(evaluations)),
-                  "time since the first ground-truth pose [s]",
-                  fmt::format("|d{}| [m]", axes[a]), 960, 340, false, true});
+    SvgPlot plot(
+        {fmt::format("Per-axis absolute error |d{}| ({})", axes[a], AlignmentSuffix(evaluations)),
+         "time since the first ground-truth pose [s]", fmt::format("|d{}| [m]", axes[a]), 960, 340,
+         false, true});
     for (std::size_t k = 0; k < evaluations.size(); ++k) {
       const TrajectoryEvaluation& e = evaluations[k];
       std::vector<double> x;
@@ -100,8 +117,8 @@ std::vector<SvgPlot> PerAxisPlots(const Trajectory& gt,
       CollectWithGaps(
           e,
           [&](std::size_t i) {
-            const double d = e.aligned_est.poses[i].translation[a] -
-                             e.pairs.gt.poses[i].translation[a];
+            const double d =
+                e.aligned_est.poses[i].translation[a] - e.pairs.gt.poses[i].translation[a];
             return std::pair<double, double>(0.0, std::abs(d));
           },
           x, y, gt.timestamps.front(), true);

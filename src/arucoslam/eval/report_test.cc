@@ -1,6 +1,7 @@
 #include "arucoslam/eval/report.h"
 
 #include <gtest/gtest.h>
+
 #include <nlohmann/json.hpp>
 
 namespace arucoslam {
@@ -9,8 +10,8 @@ namespace {
 Trajectory Line(double z_offset) {
   Trajectory t;
   for (int i = 0; i < 50; ++i) {
-    t.Add(0.1 * i, Rigid3(Eigen::Quaterniond::Identity(),
-                          Eigen::Vector3d(0.1 * i, 0.02 * i * i, z_offset)));
+    t.Add(0.1 * i,
+          Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.1 * i, 0.02 * i * i, z_offset)));
   }
   return t;
 }
@@ -33,8 +34,8 @@ TEST(Report, TableJsonAndPlotsAgreeWithTheEvaluations) {
   EXPECT_NE(table.find("RPE 1 m translation rmse [m]"), std::string::npos);
   EXPECT_NE(table.find("1 / 1"), std::string::npos);  // losses / relocalisations
 
-  const nlohmann::json json = nlohmann::json::parse(
-      FormatResultsJson(evaluations, {"a.txt", "b.txt"}, "gt.txt", options));
+  const nlohmann::json json =
+      nlohmann::json::parse(FormatResultsJson(evaluations, {"a.txt", "b.txt"}, "gt.txt", options));
   EXPECT_EQ(json["format"], "arucoslam.eval/1");
   ASSERT_EQ(json["estimates"].size(), 2u);
   const nlohmann::json& b = json["estimates"][1];

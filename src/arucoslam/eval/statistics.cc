@@ -30,8 +30,8 @@ ErrorStatistics ComputeErrorStatistics(const std::vector<double>& errors) {
 double Percentile(std::vector<double> values, double percent) {
   if (values.empty()) return 0.0;
   std::sort(values.begin(), values.end());
-  const double position = std::clamp(percent, 0.0, 100.0) / 100.0 *
-                          static_cast<double>(values.size() - 1);
+  const double position =
+      std::clamp(percent, 0.0, 100.0) / 100.0 * static_cast<double>(values.size() - 1);
   const std::size_t below = static_cast<std::size_t>(std::floor(position));
   const std::size_t above = std::min(below + 1, values.size() - 1);
   const double fraction = position - static_cast<double>(below);

@@ -8,13 +8,13 @@ namespace arucoslam {
 
 struct ErrorStatistics {
   std::size_t count = 0;
-  double rmse = 0.0;    // sqrt(mean(e^2))
+  double rmse = 0.0;  // sqrt(mean(e^2))
   double mean = 0.0;
   double median = 0.0;  // mean of the two middle values for an even count (numpy's median)
   double std = 0.0;     // population standard deviation (numpy's std, ddof = 0)
   double min = 0.0;
   double max = 0.0;
-  double sse = 0.0;     // sum of e^2
+  double sse = 0.0;  // sum of e^2
 };
 
 // All zero for an empty list.

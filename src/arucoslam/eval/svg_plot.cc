@@ -24,11 +24,20 @@ std::string Escape(const std::string& text) {
   std::string out;
   for (char c : text) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -76,7 +85,6 @@ std::string TickLabel(double value, double step) {
   return fmt::format("{:.{}f}", value, decimals);
 }
 
-
 // Legend entries laid out in rows between the title and the plot area; unlabelled series
 // are left out.
 struct LegendEntry {
@@ -85,8 +93,8 @@ struct LegendEntry {
   int row;
 };
 
-std::vector<LegendEntry> LayoutLegend(const std::vector<SvgPlot::Series>& series,
-                                      double plot_left, double plot_width, int* rows) {
+std::vector<LegendEntry> LayoutLegend(const std::vector<SvgPlot::Series>& series, double plot_left,
+                                      double plot_width, int* rows) {
   std::vector<LegendEntry> entries;
   std::vector<double> row_widths = {0.0};
   for (const SvgPlot::Series& s : series) {
@@ -223,9 +231,8 @@ std::string RenderLegend(const std::vector<SvgPlot::Series>& series, const Frame
           entry.x, cy, entry.x + kLegendSample, cy, s.color, std::max(2.5, s.stroke_width),
           s.dashed ? " stroke-dasharray=\"7,4\"" : "");
     }
-    out += fmt::format(
-        "<text x=\"{:.1f}\" y=\"{:.1f}\" font-size=\"13\" fill=\"#222\">{}</text>\n",
-        entry.x + kLegendSample + 8.0, cy + 4.5, Escape(s.label));
+    out += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" font-size=\"13\" fill=\"#222\">{}</text>\n",
+                       entry.x + kLegendSample + 8.0, cy + 4.5, Escape(s.label));
   }
   return out;
 }
@@ -259,11 +266,12 @@ std::string SvgPlot::PaletteColor(std::size_t index) {
 }
 
 void SvgPlot::AddLine(const std::vector<double>& x, const std::vector<double>& y,
-                      const std::string& label, const std::string& color,
-                      double stroke_width, bool dashed) {
+                      const std::string& label, const std::string& color, double stroke_width,
+                      bool dashed) {
   if (x.size() != y.size()) throw std::invalid_argument("SvgPlot::AddLine: sizes differ");
-  Series series{x, y, label, color.empty() ? PaletteColor(next_color_++) : color,
-                stroke_width, dashed, false};
+  Series series{
+      x,      y,    label, color.empty() ? PaletteColor(next_color_++) : color, stroke_width,
+      dashed, false};
   series_.push_back(std::move(series));
 }
 
@@ -273,9 +281,7 @@ void SvgPlot::AddMarkers(const std::vector<double>& x, const std::vector<double>
   series_.push_back(Series{x, y, label, color, radius, false, true});
 }
 
-std::string SvgPlot::Render() const {
-  return RenderSvgDocument({*this});
-}
+std::string SvgPlot::Render() const { return RenderSvgDocument({*this}); }
 
 std::string SvgPlot::RenderGroup(int offset_y) const {
   const Frame frame = ComputeFrame(options_, series_);

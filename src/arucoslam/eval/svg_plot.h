@@ -13,8 +13,8 @@ class SvgPlot {
     std::string title;
     std::string x_label;  // with the unit, e.g. "x [m]"
     std::string y_label;
-    int width = 960;      // px
-    int height = 600;     // px
+    int width = 960;            // px
+    int height = 600;           // px
     bool equal_aspect = false;  // same metres per pixel on both axes (top-down views)
     bool y_from_zero = false;   // include 0 in the y range (error plots)
 
@@ -24,9 +24,8 @@ class SvgPlot {
   explicit SvgPlot(Options options);
 
   // A polyline; a NaN in `y` breaks it (a tracking gap). `color` empty: next palette colour.
-  void AddLine(const std::vector<double>& x, const std::vector<double>& y,
-               const std::string& label, const std::string& color = "",
-               double stroke_width = 1.8, bool dashed = false);
+  void AddLine(const std::vector<double>& x, const std::vector<double>& y, const std::string& label,
+               const std::string& color = "", double stroke_width = 1.8, bool dashed = false);
   // Round markers (start/end points, samples); an empty label keeps them out of the legend.
   void AddMarkers(const std::vector<double>& x, const std::vector<double>& y,
                   const std::string& label, const std::string& color, double radius = 4.0);

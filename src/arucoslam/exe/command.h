@@ -20,6 +20,10 @@ void ParseIdRangeInto(const std::string& text, std::vector<int>& ids);
 // `markers generate | sdf | import` (markers_command.cc).
 void AddMarkersCommand(CLI::App& app, int& exit_status);
 
+// `experiments` and `demo` (experiments_command.cc).
+void AddExperimentsCommand(CLI::App& app, int& exit_status);
+void AddDemoCommand(CLI::App& app, int& exit_status);
+
 // `world factory` (world_command.cc).
 void AddWorldCommand(CLI::App& app, int& exit_status);
 

@@ -1,6 +1,7 @@
 // `arucoslam eval`: compares one or several estimated trajectories with ground truth (ATE,
 // RPE, per-axis error, scale, completeness, map accuracy), prints a table and writes
 // results.json and SVG plots to --out.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -16,6 +17,7 @@
 #include "arucoslam/io/trajectory_io.h"
 #include "arucoslam/util/error.h"
 #include "arucoslam/util/files.h"
+#include "arucoslam/util/logging.h"
 
 namespace arucoslam {
 namespace {
@@ -32,8 +34,8 @@ struct EvalArgs {
   double max_diff = 0.01;            // seconds
   bool by_index = false;
   std::vector<std::string> rpe = {"1frames"};
-  std::vector<double> at;            // seconds from the first ground-truth pose
-  double max_gap = 0.0;              // seconds, 0 = automatic
+  std::vector<double> at;  // seconds from the first ground-truth pose
+  double max_gap = 0.0;    // seconds, 0 = automatic
   std::vector<std::string> stats;
   std::vector<std::string> maps;
   std::string world;
@@ -119,9 +121,10 @@ void WriteOutputs(const EvalArgs& args, const Trajectory& gt,
     WriteTextFileAtomically(out.path() / name, svg);
   }
   out.Commit();
-  std::printf("wrote %s: results.json, table.txt, trajectory_top_down.svg, ape_over_time.svg, "
-              "per_axis_error.svg\n",
-              args.out.c_str());
+  std::printf(
+      "wrote %s: results.json, table.txt, trajectory_top_down.svg, ape_over_time.svg, "
+      "per_axis_error.svg\n",
+      args.out.c_str());
 }
 
 void RunEval(const EvalArgs& args) {
@@ -136,11 +139,18 @@ void RunEval(const EvalArgs& args) {
     const std::string label =
         args.labels.empty() ? fs::path(args.est[i]).stem().string() : args.labels[i];
     TrajectoryEvaluation evaluation = EvaluateTrajectory(gt, est, label, args.est[i], options);
+    const std::size_t shorter = std::min(gt.size(), est.size());
+    if (2 * evaluation.pairs.size() < shorter) {
+      ARUCOSLAM_LOG_WARN(
+          "{}: only {} of {} poses paired with the ground truth within {} s (a KITTI file "
+          "without time needs --by-index or a <name>_times.txt beside it)",
+          args.est[i], evaluation.pairs.size(), shorter, args.max_diff);
+    }
     if (!args.stats.empty()) evaluation.tracking = ReadRunStats(args.stats[i]);
     if (!args.maps.empty()) {
-      evaluation.map = ComputeMapAccuracy(ReadPlyPoints(args.maps[i]),
-                                          evaluation.alignment.gt_from_est, surfaces,
-                                          MapAccuracyOptions{});
+      evaluation.map =
+          ComputeMapAccuracy(ReadPlyPoints(args.maps[i]), evaluation.alignment.gt_from_est,
+                             surfaces, MapAccuracyOptions{});
     }
     evaluations.push_back(std::move(evaluation));
   }
@@ -154,10 +164,10 @@ void RunEval(const EvalArgs& args) {
 void AddEvalCommand(CLI::App& app, int& exit_status) {
   auto args = std::make_shared<EvalArgs>();
   CLI::App* eval = app.add_subcommand(
-      "eval", "ATE / RPE / per-axis error, scale and completeness of trajectories against "
-              "ground truth (TUM, EuRoC csv or KITTI files; evo's definitions)");
-  eval->add_option("--gt", args->gt, "ground-truth trajectory (TUM, EuRoC csv, KITTI)")
-      ->required();
+      "eval",
+      "ATE / RPE / per-axis error, scale and completeness of trajectories against "
+      "ground truth (TUM, EuRoC csv or KITTI files; evo's definitions)");
+  eval->add_option("--gt", args->gt, "ground-truth trajectory (TUM, EuRoC csv, KITTI)")->required();
   eval->add_option("--est", args->est, "estimated trajectory; repeat to compare several")
       ->required();
   eval->add_option("--label", args->labels, "name of each estimate (default: file stem)");
@@ -170,8 +180,7 @@ void AddEvalCommand(CLI::App& app, int& exit_status) {
                    "fit the alignment on pairs in START END (seconds from the first "
                    "ground-truth pose)")
       ->expected(2);
-  eval->add_option("--max-diff", args->max_diff,
-                   "largest time difference for a pose pair, seconds")
+  eval->add_option("--max-diff", args->max_diff, "largest time difference for a pose pair, seconds")
       ->capture_default_str();
   eval->add_flag("--by-index", args->by_index,
                  "pair pose i with pose i (files without time, e.g. KITTI)");

@@ -1,12 +1,12 @@
 // Runs the `arucoslam eval` binary: evo's numbers on its test data, the files it writes,
 // and one clear line with exit status 2 for each kind of bad input.
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 
 #include "arucoslam/util/files.h"
 
@@ -86,12 +86,11 @@ TEST_F(EvalCommandTest, ReproducesEvoAndWritesResultsAndPlots) {
   EXPECT_NEAR(mono["rpe"][0]["translation_m"]["rmse"].get<double>(), 0.007069, 5e-7);
   EXPECT_EQ(mono["rpe"][0]["translation_m"]["count"], 117);
   EXPECT_EQ(json["estimates"][1]["poses"]["pairs"], 2174);
-  for (const char* name : {"trajectory_top_down.svg", "ape_over_time.svg", "per_axis_error.svg",
-                           "table.txt"}) {
+  for (const char* name :
+       {"trajectory_top_down.svg", "ape_over_time.svg", "per_axis_error.svg", "table.txt"}) {
     EXPECT_TRUE(fs::is_regular_file(out / name)) << name;
   }
-  EXPECT_NE(ReadTextFile(out / "trajectory_top_down.svg").find(">full</text>"),
-            std::string::npos);
+  EXPECT_NE(ReadTextFile(out / "trajectory_top_down.svg").find(">full</text>"), std::string::npos);
 }
 
 TEST_F(EvalCommandTest, StatsFileIsReported) {
@@ -105,6 +104,42 @@ TEST_F(EvalCommandTest, StatsFileIsReported) {
   const nlohmann::json json = nlohmann::json::parse(ReadTextFile(folder_ / "o" / "results.json"));
   EXPECT_EQ(json["estimates"][0]["tracking"]["relocalisations"], 1);
   EXPECT_EQ(json["estimates"][0]["ape"]["translation_m"]["rmse"].get<double>(), 0.0);
+}
+
+TEST_F(EvalCommandTest, MapAccuracyAgainstAnSdfWorld) {
+  const fs::path gt = WriteGroundTruth();
+  // A 2 m cube standing on z = 0 at x = 10; map points 1, 2 and 3 cm and 1 m from its faces.
+  const fs::path world = Write("world.sdf", R"(<?xml version="1.0"?>
+<sdf version="1.9">
+  <world name="w">
+    <model name="cube">
+      <static>true</static>
+      <pose>10 0 1 0 0 0</pose>
+      <link name="link">
+        <visual name="v"><geometry><box><size>2 2 2</size></box></geometry></visual>
+      </link>
+    </model>
+  </world>
+</sdf>
+)");
+  const fs::path map = Write("map.ply",
+                             "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\n"
+                             "property float y\nproperty float z\nend_header\n"
+                             "8.99 0 1\n10 1.02 1\n10 0 2.03\n12 0 1\n");
+  const fs::path out = folder_ / "o";
+  const RunResult run = Run("--gt " + gt.string() + " --est " + gt.string() + " --map " +
+                            map.string() + " --world " + world.string() + " --out " +
+                            out.string());
+  ASSERT_EQ(run.status, 0) << run.err;
+  const nlohmann::json json = nlohmann::json::parse(ReadTextFile(out / "results.json"));
+  const nlohmann::json& accuracy = json["estimates"][0]["map"];
+  EXPECT_EQ(accuracy["points"], 4);
+  EXPECT_NEAR(accuracy["median_m"].get<double>(), 0.025, 1e-6);
+  EXPECT_NEAR(accuracy["fraction_within"].get<double>(), 0.75, 1e-12);
+  const RunResult no_world =
+      Run("--gt " + gt.string() + " --est " + gt.string() + " --map " + map.string());
+  EXPECT_EQ(no_world.status, 2);
+  EXPECT_NE(no_world.err.find("--map: map accuracy needs the true world"), std::string::npos);
 }
 
 TEST_F(EvalCommandTest, BadInputIsOneLineAndStatusTwo) {
@@ -138,8 +173,8 @@ TEST_F(EvalCommandTest, BadInputIsOneLineAndStatusTwo) {
   const RunResult bad_rpe = Run("--gt " + gt.string() + " --est " + gt.string() + " --rpe 3x");
   EXPECT_EQ(bad_rpe.status, 2);
   EXPECT_NE(bad_rpe.err.find("--rpe: cannot read '3x'"), std::string::npos);
-  const RunResult missing = Run("--gt " + (folder_ / "nope.txt").string() + " --est " +
-                                gt.string());
+  const RunResult missing =
+      Run("--gt " + (folder_ / "nope.txt").string() + " --est " + gt.string());
   EXPECT_EQ(missing.status, 2);
   EXPECT_NE(missing.err.find("nope.txt"), std::string::npos);
 }

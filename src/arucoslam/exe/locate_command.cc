@@ -1,11 +1,10 @@
 // `arucoslam locate`: the camera pose in the world from one image and a marker map (the
 // computation behind the paper's Table 1), printed as text or, with --json, as JSON.
-#include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
-
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <string>
 
 #include "arucoslam/exe/command.h"
@@ -34,14 +33,14 @@ CornerRefinement RefinementFromName(const std::string& name) {
   if (name == "subpix") return CornerRefinement::kSubpix;
   if (name == "contour") return CornerRefinement::kContour;
   if (name == "apriltag") return CornerRefinement::kAprilTag;
-  throw InputError("--refinement", "unknown refinement '" + name +
-                                       "' (accepted: none, subpix, contour, apriltag)");
+  throw InputError("--refinement",
+                   "unknown refinement '" + name + "' (accepted: none, subpix, contour, apriltag)");
 }
 
 nlohmann::json PoseJson(const Rigid3& pose) {
   const Eigen::Quaterniond& q = pose.rotation;
-  return {{"position", {{"x", pose.translation.x()}, {"y", pose.translation.y()},
-                        {"z", pose.translation.z()}}},
+  return {{"position",
+           {{"x", pose.translation.x()}, {"y", pose.translation.y()}, {"z", pose.translation.z()}}},
           {"orientation", {{"x", q.x()}, {"y", q.y()}, {"z", q.z()}, {"w", q.w()}}}};
 }
 
@@ -87,11 +86,12 @@ void PrintText(const CameraLocation& location) {
               location.quality.num_corners, location.quality.reprojection_rms_px);
   std::printf("unknown markers: %s\n", IdList(location.unknown_marker_ids).c_str());
   if (location.quality.ambiguous) {
-    std::printf("warning: ambiguous pose (one marker, IPPE error ratio %.2f); alternative "
-                "position %.4f %.4f %.4f\n", location.quality.error_ratio,
-                location.alternative_world_from_cam->translation.x(),
-                location.alternative_world_from_cam->translation.y(),
-                location.alternative_world_from_cam->translation.z());
+    std::printf(
+        "warning: ambiguous pose (one marker, IPPE error ratio %.2f); alternative "
+        "position %.4f %.4f %.4f\n",
+        location.quality.error_ratio, location.alternative_world_from_cam->translation.x(),
+        location.alternative_world_from_cam->translation.y(),
+        location.alternative_world_from_cam->translation.z());
   }
 }
 
@@ -106,8 +106,8 @@ int RunLocate(const LocateArgs& args) {
   if (image.cols != camera.width || image.rows != camera.height) {
     throw InputError(args.image, "image is " + std::to_string(image.cols) + "x" +
                                      std::to_string(image.rows) + " but the calibration " +
-                                     args.camera + " is for " + std::to_string(camera.width) +
-                                     "x" + std::to_string(camera.height));
+                                     args.camera + " is for " + std::to_string(camera.width) + "x" +
+                                     std::to_string(camera.height));
   }
   if (!(args.inlier_threshold_px > 0.0)) {
     throw InputError("--inlier-threshold", "expected a positive number of pixels");
@@ -137,17 +137,20 @@ void AddLocateCommand(CLI::App& app, int& exit_status) {
   CLI::App* locate = app.add_subcommand(
       "locate", "Camera pose in the world from one image and a marker map (markers.json)");
   locate->add_option("--image", args->image, "the image (any format OpenCV reads)")->required();
-  locate->add_option("--camera", args->camera,
-                     "calibration: EuRoC sensor.yaml, ORB-SLAM3 settings or ROS camera_info")
+  locate
+      ->add_option("--camera", args->camera,
+                   "calibration: EuRoC sensor.yaml, ORB-SLAM3 settings or ROS camera_info")
       ->required();
   locate->add_option("--markers", args->markers, "the marker map, markers.json")->required();
   locate->add_flag("--json", args->json, "print the result as JSON");
   locate->add_flag("--clahe", args->clahe, "equalise contrast (CLAHE) before detection");
-  locate->add_option("--refinement", args->refinement,
-                     "corner refinement: none, subpix, contour or apriltag")
+  locate
+      ->add_option("--refinement", args->refinement,
+                   "corner refinement: none, subpix, contour or apriltag")
       ->capture_default_str();
-  locate->add_option("--inlier-threshold", args->inlier_threshold_px,
-                     "reprojection error of an inlier corner, pixels")
+  locate
+      ->add_option("--inlier-threshold", args->inlier_threshold_px,
+                   "reprojection error of an inlier corner, pixels")
       ->capture_default_str();
   locate->callback([args, &exit_status] { exit_status = RunLocate(*args); });
 }

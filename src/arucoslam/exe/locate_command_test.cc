@@ -4,11 +4,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
-
 #include <cstdlib>
 #include <filesystem>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <tuple>
 
 #include "arucoslam/io/calibration.h"
@@ -72,9 +71,10 @@ class LocateCommandTest : public ::testing::Test {
     for (const auto& [id, yaw, position] :
          {std::tuple{3, 0.35, Eigen::Vector3d(-0.5, 0.15, 2.0)},
           std::tuple{8, -0.35, Eigen::Vector3d(0.5, -0.1, 2.2)}}) {
-      placed.emplace_back(id, Rigid3(Eigen::Matrix3d(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY()) *
-                                                     Eigen::Vector3d(1, -1, -1).asDiagonal()),
-                                     position));
+      placed.emplace_back(id,
+                          Rigid3(Eigen::Matrix3d(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY()) *
+                                                 Eigen::Vector3d(1, -1, -1).asDiagonal()),
+                                 position));
     }
     std::vector<SyntheticMarker> markers;
     MarkerMap map;
@@ -148,12 +148,13 @@ TEST_F(LocateCommandTest, NoKnownMarkerExitsOneWithAReason) {
 
 TEST_F(LocateCommandTest, BadInputIsOneLineAndStatusTwo) {
   WriteScene({3});
-  for (const std::string& arguments :
-       {"locate --image " + (folder_ / "missing.png").string() + " --camera " +
-            (folder_ / "camera.yaml").string() + " --markers " + (folder_ / "markers.json").string(),
-        "locate --image " + (folder_ / "camera.yaml").string() + " --camera " +
-            (folder_ / "camera.yaml").string() + " --markers " + (folder_ / "markers.json").string(),
-        Args(" --refinement sharp")}) {
+  for (const std::string& arguments : {"locate --image " + (folder_ / "missing.png").string() +
+                                           " --camera " + (folder_ / "camera.yaml").string() +
+                                           " --markers " + (folder_ / "markers.json").string(),
+                                       "locate --image " + (folder_ / "camera.yaml").string() +
+                                           " --camera " + (folder_ / "camera.yaml").string() +
+                                           " --markers " + (folder_ / "markers.json").string(),
+                                       Args(" --refinement sharp")}) {
     const RunResult result = Run(arguments);
     EXPECT_EQ(result.status, 2) << arguments;
     EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
@@ -179,10 +180,9 @@ TEST_F(LocateCommandTest, RealPhoto403AgreesWithPeer) {
   info.size = 0.145;
   map.markers[403] = info;
   WriteMarkerMapJson(map, folder_ / "markers.json");
-  const RunResult result =
-      Run("locate --json --image " + (dir / "images/403.jpg").string() + " --camera " +
-          (dir / "camera_test_images.yaml").string() + " --markers " +
-          (folder_ / "markers.json").string());
+  const RunResult result = Run("locate --json --image " + (dir / "images/403.jpg").string() +
+                               " --camera " + (dir / "camera_test_images.yaml").string() +
+                               " --markers " + (folder_ / "markers.json").string());
   ASSERT_EQ(result.status, 0) << result.err;
   const nlohmann::json json = nlohmann::json::parse(result.out);
   const auto rpy = [](double roll, double pitch, double yaw) {
@@ -192,7 +192,8 @@ TEST_F(LocateCommandTest, RealPhoto403AgreesWithPeer) {
   };
   const Rigid3 base_from_cam(rpy(-1.204205, -0.041544, -1.479119),
                              Eigen::Vector3d(0.035, 0.145, 0.14));
-  const Rigid3 base_from_marker(rpy(1.5751, -0.014, -1.546), Eigen::Vector3d(0.7611, 0.2505, 0.4028));
+  const Rigid3 base_from_marker(rpy(1.5751, -0.014, -1.546),
+                                Eigen::Vector3d(0.7611, 0.2505, 0.4028));
   const Rigid3 expected = base_from_marker.Inverse() * base_from_cam;
   EXPECT_LT((Position(json["world_from_cam"]) - expected.translation).norm(), 0.01);
 }

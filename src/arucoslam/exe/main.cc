@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
 
   int exit_status = kExitOk;
   // Subcommands (one file each, *_command.cc).
+  AddDemoCommand(app, exit_status);
   AddMarkersCommand(app, exit_status);
   AddWorldCommand(app, exit_status);
   AddEvalCommand(app, exit_status);
@@ -31,6 +32,7 @@ int main(int argc, char** argv) {
   AddLocateCommand(app, exit_status);
   AddRunCommand(app, exit_status);
   AddVocabCommand(app, exit_status);
+  AddExperimentsCommand(app, exit_status);
   (void)exit_status;
 
   try {

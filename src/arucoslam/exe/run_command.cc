@@ -1,6 +1,7 @@
 // `arucoslam run`: monocular SLAM over a sequence (EuRoC layout, TUM RGB-D folder or image
 // folder) -> trajectory.tum, keyframes.tum, map.ply and stats.json in one output folder.
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -77,6 +78,12 @@ int RunSlam(const RunArgs& args) {
   SystemOptions options;
   options.blocking = args.blocking;
   options.extractor.num_features = args.num_features;
+  // EXPERIMENT-TOGGLES
+  if (std::getenv("EXP_NOFUSE")) options.mapper.fusion_neighbours = 0;
+  if (std::getenv("EXP_NOCULL")) options.mapper.cull_keyframes = false;
+  if (std::getenv("EXP_MINF")) options.keyframes.min_frames_between = std::atoi(std::getenv("EXP_MINF"));
+  if (std::getenv("EXP_FIXED")) options.mapper.bundle_adjustment.min_fixed_keyframes = std::atoi(std::getenv("EXP_FIXED"));
+  if (std::getenv("EXP_NOBA")) options.mapper.run_bundle_adjustment = false;
   StagedDirectory staged(args.out);
   const Stopwatch wall;
   System system(dataset.camera(), options);

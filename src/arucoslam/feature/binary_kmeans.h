@@ -3,7 +3,6 @@
 #pragma once
 
 #include <array>
-#include <bit>
 #include <cstdint>
 #include <cstring>
 #include <random>
@@ -15,6 +14,15 @@ namespace arucoslam {
 
 using BinaryDescriptor = std::array<std::uint8_t, kOrbDescriptorBytes>;
 
+// Set bits of a 64-bit word, branch-free (the portable build has no popcnt instruction, and
+// std::popcount would call a library routine).
+inline int CountBits(std::uint64_t x) {
+  x = x - ((x >> 1) & 0x5555555555555555ull);
+  x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
+  x = (x + (x >> 4)) & 0x0f0f0f0f0f0f0f0full;
+  return static_cast<int>((x * 0x0101010101010101ull) >> 56);
+}
+
 // Bits that differ between two 32-byte descriptors (0..256).
 inline int DescriptorDistance(const std::uint8_t* a, const std::uint8_t* b) {
   int bits = 0;
@@ -23,7 +31,7 @@ inline int DescriptorDistance(const std::uint8_t* a, const std::uint8_t* b) {
     std::uint64_t wb;
     std::memcpy(&wa, a + k, 8);
     std::memcpy(&wb, b + k, 8);
-    bits += std::popcount(wa ^ wb);
+    bits += CountBits(wa ^ wb);
   }
   return bits;
 }
@@ -41,7 +49,7 @@ struct KMajorityOptions {
 };
 
 struct KMajorityResult {
-  std::vector<BinaryDescriptor> centers;         // no empty cluster
+  std::vector<BinaryDescriptor> centers;            // no empty cluster
   std::vector<std::vector<std::uint32_t>> members;  // members[c]: entries of `selection`
 };
 

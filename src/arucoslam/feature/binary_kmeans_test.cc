@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <set>
 
 namespace arucoslam {
@@ -37,6 +38,11 @@ TEST(BinaryKMeans, DescriptorDistanceCountsBits) {
   EXPECT_EQ(DescriptorDistance(a.data(), b.data()), 10);
   b.fill(0xff);
   EXPECT_EQ(DescriptorDistance(a.data(), b.data()), 256);
+  std::mt19937_64 rng(2);
+  for (int i = 0; i < 1000; ++i) {
+    const std::uint64_t word = rng() >> (i % 64);
+    EXPECT_EQ(CountBits(word), std::popcount(word)) << word;
+  }
 }
 
 TEST(BinaryKMeans, MajorityIsTheBitwiseVoteAndMinimisesTheSummedDistance) {

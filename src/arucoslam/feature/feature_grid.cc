@@ -7,7 +7,7 @@
 namespace arucoslam {
 
 FeatureGrid::FeatureGrid(const OrbFeatures& features, double cell_size_px)
-    : features_(&features), cell_size_(cell_size_px) {
+    : cell_size_(cell_size_px) {
   if (!(cell_size_px > 0.0)) throw std::invalid_argument("FeatureGrid: cell size must be > 0");
   double max_x = features.image_width, max_y = features.image_height;
   for (const cv::KeyPoint& kp : features.keypoints) {
@@ -21,7 +21,7 @@ FeatureGrid::FeatureGrid(const OrbFeatures& features, double cell_size_px)
     const cv::Point2f& p = features.keypoints[i].pt;
     const int cx = std::clamp(static_cast<int>(std::floor(p.x / cell_size_)), 0, cells_x_ - 1);
     const int cy = std::clamp(static_cast<int>(std::floor(p.y / cell_size_)), 0, cells_y_ - 1);
-    cells_[cy * cells_x_ + cx].push_back(i);
+    cells_[cy * cells_x_ + cx].push_back({p.x, p.y, features.keypoints[i].octave, i});
   }
 }
 
@@ -38,15 +38,13 @@ std::vector<int> FeatureGrid::FeaturesInRadius(const Eigen::Vector2d& pixel, dou
   const double radius2 = radius_px * radius_px;
   for (int cy = y0; cy <= y1; ++cy) {
     for (int cx = x0; cx <= x1; ++cx) {
-      for (int index : cells_[cy * cells_x_ + cx]) {
-        const cv::KeyPoint& kp = features_->keypoints[index];
-        if (kp.octave < min_level || (max_level >= 0 && kp.octave > max_level)) continue;
-        const double dx = kp.pt.x - pixel.x(), dy = kp.pt.y - pixel.y();
-        if (dx * dx + dy * dy <= radius2) found.push_back(index);
+      for (const Entry& entry : cells_[cy * cells_x_ + cx]) {
+        if (entry.level < min_level || (max_level >= 0 && entry.level > max_level)) continue;
+        const double dx = entry.x - pixel.x(), dy = entry.y - pixel.y();
+        if (dx * dx + dy * dy <= radius2) found.push_back(entry.index);
       }
     }
   }
-  std::sort(found.begin(), found.end());
   return found;
 }
 

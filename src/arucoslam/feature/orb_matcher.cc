@@ -1,7 +1,6 @@
 #include "arucoslam/feature/orb_matcher.h"
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -57,12 +56,18 @@ std::vector<float> Angles(const OrbFeatures& features) {
 }  // namespace
 
 int HammingDistance(const std::uint8_t* a, const std::uint8_t* b) {
+  // Bit-parallel count: the portable build has no popcnt instruction, and std::popcount
+  // then becomes a library call per word.
   int bits = 0;
   for (int k = 0; k < kOrbDescriptorBytes; k += 8) {
     std::uint64_t wa, wb;
     std::memcpy(&wa, a + k, 8);
     std::memcpy(&wb, b + k, 8);
-    bits += std::popcount(wa ^ wb);
+    std::uint64_t x = wa ^ wb;
+    x = x - ((x >> 1) & 0x5555555555555555ULL);
+    x = (x & 0x3333333333333333ULL) + ((x >> 2) & 0x3333333333333333ULL);
+    x = (x + (x >> 4)) & 0x0F0F0F0F0F0F0F0FULL;
+    bits += static_cast<int>((x * 0x0101010101010101ULL) >> 56);
   }
   return bits;
 }

@@ -146,7 +146,9 @@ TEST(FeatureGrid, FindsExactlyThePointsInTheCircle) {
       if (kp.octave < 1 || kp.octave > 2) continue;
       if (std::hypot(kp.pt.x - centre.x(), kp.pt.y - centre.y()) <= radius) expected.push_back(i);
     }
-    EXPECT_EQ(grid.FeaturesInRadius(centre, radius, 1, 2), expected);
+    std::vector<int> found = grid.FeaturesInRadius(centre, radius, 1, 2);
+    std::sort(found.begin(), found.end());
+    EXPECT_EQ(found, expected);
   }
 }
 

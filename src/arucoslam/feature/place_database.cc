@@ -14,11 +14,18 @@ PlaceDatabase::PlaceDatabase(std::size_t num_words) : inverted_(num_words) {}
 
 void PlaceDatabase::Add(std::uint64_t entry, const BowVector& bow, FeatureVector direct) {
   Erase(entry);
+  std::uint32_t slot = num_slots_;
+  if (free_slots_.empty()) {
+    ++num_slots_;
+  } else {
+    slot = free_slots_.back();
+    free_slots_.pop_back();
+  }
   for (const BowVector::Entry& word : bow.entries) {
     if (word.word >= inverted_.size()) inverted_.resize(word.word + 1);
-    inverted_[word.word].push_back({entry, word.weight});
+    inverted_[word.word].push_back({entry, slot, word.weight});
   }
-  entries_[entry] = Stored{bow, std::move(direct)};
+  entries_[entry] = Stored{bow, std::move(direct), slot};
 }
 
 bool PlaceDatabase::Erase(std::uint64_t entry) {
@@ -28,6 +35,7 @@ bool PlaceDatabase::Erase(std::uint64_t entry) {
     std::vector<Posting>& postings = inverted_[word.word];
     std::erase_if(postings, [entry](const Posting& p) { return p.entry == entry; });
   }
+  free_slots_.push_back(it->second.slot);
   entries_.erase(it);
   return true;
 }
@@ -35,28 +43,33 @@ bool PlaceDatabase::Erase(std::uint64_t entry) {
 void PlaceDatabase::Clear() {
   for (std::vector<Posting>& postings : inverted_) postings.clear();
   entries_.clear();
+  num_slots_ = 0;
+  free_slots_.clear();
 }
 
-std::vector<PlaceMatch> PlaceDatabase::Query(const BowVector& bow,
-                                             const PlaceQueryOptions& options,
+std::vector<PlaceMatch> PlaceDatabase::Query(const BowVector& bow, const PlaceQueryOptions& options,
                                              const std::function<bool(std::uint64_t)>& keep) const {
   if (!options.Check()) throw std::invalid_argument("PlaceDatabase::Query: bad options");
   // Accumulates, per entry, sum over shared words of |q| + |e| - |q - e| (= 2 min(q, e) for
   // non-negative weights): twice the L1 score.
-  std::unordered_map<std::uint64_t, PlaceMatch> accumulated;
+  std::vector<PlaceMatch> accumulated(num_slots_);
+  std::vector<std::uint32_t> touched;
   for (const BowVector::Entry& word : bow.entries) {
     if (word.word >= inverted_.size()) continue;
     for (const Posting& posting : inverted_[word.word]) {
-      PlaceMatch& match = accumulated[posting.entry];
+      PlaceMatch& match = accumulated[posting.slot];
+      if (match.num_shared_words == 0) touched.push_back(posting.slot);
       match.entry = posting.entry;
-      match.score += std::abs(word.weight) + std::abs(posting.weight) -
-                     std::abs(word.weight - posting.weight);
+      match.score +=
+          std::abs(word.weight) + std::abs(posting.weight) - std::abs(word.weight - posting.weight);
       ++match.num_shared_words;
     }
   }
   std::vector<PlaceMatch> matches;
-  matches.reserve(accumulated.size());
-  for (auto& [entry, match] : accumulated) {
+  matches.reserve(touched.size());
+  for (std::uint32_t slot : touched) {
+    PlaceMatch& match = accumulated[slot];
+    const std::uint64_t entry = match.entry;
     match.score = std::clamp(0.5 * match.score, 0.0, 1.0);
     if (match.score < options.min_score || match.num_shared_words < options.min_shared_words) {
       continue;

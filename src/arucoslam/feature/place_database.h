@@ -12,15 +12,15 @@
 namespace arucoslam {
 
 struct PlaceMatch {
-  std::uint64_t entry = 0;    // the id given to Add()
-  double score = 0.0;         // L1Score of the query and the entry, (0, 1]
-  int num_shared_words = 0;   // words present in both
+  std::uint64_t entry = 0;   // the id given to Add()
+  double score = 0.0;        // L1Score of the query and the entry, (0, 1]
+  int num_shared_words = 0;  // words present in both
 };
 
 struct PlaceQueryOptions {
-  int max_results = 10;     // at most this many matches, best first (>= 1)
-  double min_score = 0.0;   // matches scoring below this are dropped ([0, 1])
-  int min_shared_words = 1; // matches sharing fewer words are dropped (>= 1)
+  int max_results = 10;      // at most this many matches, best first (>= 1)
+  double min_score = 0.0;    // matches scoring below this are dropped ([0, 1])
+  int min_shared_words = 1;  // matches sharing fewer words are dropped (>= 1)
   bool Check() const;
 };
 
@@ -53,6 +53,7 @@ class PlaceDatabase {
   // The inverted list of a word: entries holding it, with their weights.
   struct Posting {
     std::uint64_t entry = 0;
+    std::uint32_t slot = 0;  // internal: where the entry's score accumulates in a query
     double weight = 0.0;
   };
   // (empty for a word no entry holds).
@@ -62,9 +63,13 @@ class PlaceDatabase {
   struct Stored {
     BowVector bow;
     FeatureVector direct;
+    std::uint32_t slot = 0;
   };
   std::vector<std::vector<Posting>> inverted_;
   std::unordered_map<std::uint64_t, Stored> entries_;
+  // Slots give each stored entry a small dense index for the score accumulator.
+  std::uint32_t num_slots_ = 0;
+  std::vector<std::uint32_t> free_slots_;
 };
 
 // PlaceDatabase keyed by a typed id (e.g. KeyframeId from map/ids.h) instead of a raw value.
@@ -91,8 +96,8 @@ class TypedPlaceDatabase {
     }
     std::vector<Match> matches;
     for (const PlaceMatch& m : database_.Query(bow, options, keep_raw)) {
-      matches.push_back({Id(static_cast<typename Id::ValueType>(m.entry)), m.score,
-                         m.num_shared_words});
+      matches.push_back(
+          {Id(static_cast<typename Id::ValueType>(m.entry)), m.score, m.num_shared_words});
     }
     return matches;
   }

@@ -24,13 +24,13 @@ struct VocabularyOptions {
 class Vocabulary {
  public:
   struct Node {
-    NodeId parent = 0;        // root: itself (0)
-    NodeId first_child = 0;   // children are contiguous: first_child .. +num_children-1
+    NodeId parent = 0;               // root: itself (0)
+    NodeId first_child = 0;          // children are contiguous: first_child .. +num_children-1
     std::uint32_t num_children = 0;  // 0 for a leaf (a word)
-    std::uint32_t depth = 0;  // root 0, its children 1, ...
-    WordId word = 0;          // leaves only: index of the word
-    double weight = 0.0;      // leaves only: idf = ln(N / n_w) over the training images
-    BinaryDescriptor descriptor{};  // cluster centre (root: zeros)
+    std::uint32_t depth = 0;         // root 0, its children 1, ...
+    WordId word = 0;                 // leaves only: index of the word
+    double weight = 0.0;             // leaves only: idf = ln(N / n_w) over the training images
+    BinaryDescriptor descriptor{};   // cluster centre (root: zeros)
     friend bool operator==(const Node&, const Node&) = default;
   };
 
@@ -42,7 +42,7 @@ class Vocabulary {
   static Vocabulary Train(const std::vector<cv::Mat>& descriptors_per_image,
                           const VocabularyOptions& options);
 
-  // Binary file (format in docs/vocabulary_format.md, see vocabulary_io.cc). Load throws
+  // Binary file (format at the top of vocabulary_io.cc). Load throws
   // InputError naming the file for a missing file, wrong magic or version, a truncated or
   // corrupted file; Save throws InputError when the file cannot be written (atomic write).
   static Vocabulary Load(const std::filesystem::path& path);
@@ -84,8 +84,8 @@ class Vocabulary {
   int branching_ = 0;
   int levels_ = 0;
   std::uint32_t num_training_images_ = 0;
-  std::vector<Node> nodes_;     // breadth-first; nodes_[0] is the root
-  std::vector<NodeId> words_;   // leaf node of each word, in node order
+  std::vector<Node> nodes_;    // breadth-first; nodes_[0] is the root
+  std::vector<NodeId> words_;  // leaf node of each word, in node order
 };
 
 }  // namespace arucoslam

@@ -128,8 +128,8 @@ void Vocabulary::LinkTree(const std::string& source) {
     const NodeId parent = nodes_[i].parent;
     const bool ordered = parent < i && (i == 1 || parent >= nodes_[i - 1].parent);
     if (!ordered) {
-      throw InputError(source, "node " + std::to_string(i) + ": parent " +
-                                   std::to_string(parent) + " out of breadth-first order");
+      throw InputError(source, "node " + std::to_string(i) + ": parent " + std::to_string(parent) +
+                                   " out of breadth-first order");
     }
     Node& p = nodes_[parent];
     if (p.num_children == 0) p.first_child = static_cast<NodeId>(i);

@@ -166,7 +166,7 @@ TEST_F(VocabularyTest, ScoresAreOneForTheSameImageAndZeroForDisjointOnes) {
 
 TEST_F(VocabularyTest, DirectIndexGroupsFeaturesByNode) {
   std::mt19937_64 rng(21);
-  std::vector<BinaryDescriptor> image = world_->Sample(0, 2, rng);  // top 0
+  std::vector<BinaryDescriptor> image = world_->Sample(0, 2, rng);     // top 0
   for (const auto& d : world_->Sample(1, 2, rng)) image.push_back(d);  // top 0
   for (const auto& d : world_->Sample(4, 3, rng)) image.push_back(d);  // top 1
   BowVector bow;

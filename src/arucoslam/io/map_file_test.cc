@@ -73,6 +73,7 @@ MapData BuildTestMap(int num_keyframes, int num_keypoints, int num_points, std::
   for (int j = 0; j < num_points; ++j) {
     MapPoint point;
     point.p_in_world = Eigen::Vector3d(4 * uniform(random), 2 * uniform(random), 5);
+    point.reference_keyframe = KeyframeId(j % num_keyframes);  // ids the keyframes will get
     points.push_back(data.AddMapPoint(point));
   }
   std::vector<KeyframeId> keyframes;
@@ -247,6 +248,11 @@ TEST(MapFileTest, Fnv1aMatchesReferenceValues) {
 TEST(MapFileTest, RoundTripKeepsEveryField) {
   const MapData original = BuildTestMap(9, 60, 150, 1);
   ASSERT_GT(original.NumMapPoints(), 100u);
+  int with_reference = 0;
+  for (const auto& [id, point] : original.map_points()) {
+    with_reference += point.reference_keyframe.IsValid() ? 1 : 0;
+  }
+  ASSERT_GT(with_reference, 0);
   const std::string bytes = SerializeMap(original);
   const MapData loaded = DeserializeMap(bytes, "test.map");
   EXPECT_EQ(loaded.CheckInvariants(), "");
@@ -303,6 +309,7 @@ TEST(MapFileTest, MissingFileNamesIt) {
     EXPECT_EQ(error.source(), path.string());
     EXPECT_NE(error.message().find("does not exist"), std::string::npos) << error.message();
   }
+  fs::remove_all(path.parent_path());
 }
 
 TEST(MapFileTest, WrongMagicIsNotAMap) {

@@ -1,10 +1,10 @@
 #include "arucoslam/io/trajectory_io.h"
 
-#include <nlohmann/json.hpp>
+#include <fmt/format.h>
 
 #include <charconv>
 #include <cmath>
-#include <fmt/format.h>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "arucoslam/util/error.h"
@@ -46,12 +46,11 @@ std::vector<NumberLine> SplitNumberLines(const std::string& text, const std::str
       double value = 0.0;
       const auto result = std::from_chars(begin, token.data() + token.size(), value);
       if (result.ec != std::errc() || result.ptr != token.data() + token.size()) {
-        throw InputError(source, fmt::format("line {}: '{}' is not a number", line_number,
-                                             token));
+        throw InputError(source, fmt::format("line {}: '{}' is not a number", line_number, token));
       }
       if (!std::isfinite(value)) {
-        throw InputError(source, fmt::format("line {}: value '{}' is not finite", line_number,
-                                             token));
+        throw InputError(source,
+                         fmt::format("line {}: value '{}' is not finite", line_number, token));
       }
       parsed.values.push_back(value);
       parsed.tokens.push_back(token);
@@ -67,8 +66,8 @@ void RequireCount(const NumberLine& line, std::size_t expected, bool at_least,
   const bool ok = at_least ? line.values.size() >= expected : line.values.size() == expected;
   if (!ok) {
     throw InputError(source, fmt::format("line {}: expected {}{} numbers ({}), found {}",
-                                         line.line_number, at_least ? "at least " : "",
-                                         expected, format_name, line.values.size()));
+                                         line.line_number, at_least ? "at least " : "", expected,
+                                         format_name, line.values.size()));
   }
 }
 
@@ -77,8 +76,8 @@ Eigen::Quaterniond CheckedQuaternion(double w, double x, double y, double z, int
   const Eigen::Quaterniond q(w, x, y, z);
   const double norm = q.norm();
   if (norm < 0.5 || norm > 1.5) {
-    throw InputError(source, fmt::format("line {}: quaternion norm {:.6g} is far from 1",
-                                         line_number, norm));
+    throw InputError(
+        source, fmt::format("line {}: quaternion norm {:.6g} is far from 1", line_number, norm));
   }
   return q;
 }
@@ -105,10 +104,10 @@ Trajectory ParseTumTrajectory(const std::string& text, const std::string& source
   for (const NumberLine& line : SplitNumberLines(text, source)) {
     RequireCount(line, 8, false, source, "TUM: t tx ty tz qx qy qz qw");
     const std::vector<double>& v = line.values;
-    const Eigen::Quaterniond q = CheckedQuaternion(v[7], v[4], v[5], v[6], line.line_number,
-                                                   source);
-    AddChecked(trajectory, v[0], Rigid3(q, Eigen::Vector3d(v[1], v[2], v[3])),
-               line.line_number, source);
+    const Eigen::Quaterniond q =
+        CheckedQuaternion(v[7], v[4], v[5], v[6], line.line_number, source);
+    AddChecked(trajectory, v[0], Rigid3(q, Eigen::Vector3d(v[1], v[2], v[3])), line.line_number,
+               source);
   }
   RequireNotEmpty(trajectory, source);
   return trajectory;
@@ -119,8 +118,8 @@ Trajectory ParseEurocTrajectory(const std::string& text, const std::string& sour
   for (const NumberLine& line : SplitNumberLines(text, source)) {
     RequireCount(line, 8, true, source, "EuRoC: t[ns] px py pz qw qx qy qz ...");
     const std::vector<double>& v = line.values;
-    const Eigen::Quaterniond q = CheckedQuaternion(v[4], v[5], v[6], v[7], line.line_number,
-                                                   source);
+    const Eigen::Quaterniond q =
+        CheckedQuaternion(v[4], v[5], v[6], v[7], line.line_number, source);
     // Nanoseconds as a double, then seconds: the same rounding as evo's reader.
     AddChecked(trajectory, v[0] / 1e9, Rigid3(q, Eigen::Vector3d(v[1], v[2], v[3])),
                line.line_number, source);
@@ -137,8 +136,8 @@ Trajectory ParseKittiTrajectory(const std::string& text, const std::string& sour
   if (times_text) {
     times = SplitNumberLines(*times_text, times_source);
     if (times.size() != lines.size()) {
-      throw InputError(times_source, fmt::format("{} timestamps for {} poses in {}",
-                                                 times.size(), lines.size(), source));
+      throw InputError(times_source, fmt::format("{} timestamps for {} poses in {}", times.size(),
+                                                 lines.size(), source));
     }
   }
   Trajectory trajectory;
@@ -181,8 +180,7 @@ Trajectory ReadKittiTrajectory(const std::filesystem::path& path,
                                const std::optional<std::filesystem::path>& times_path) {
   const std::string text = ReadTextFile(path);
   if (!times_path) return ParseKittiTrajectory(text, path.string());
-  return ParseKittiTrajectory(text, path.string(), ReadTextFile(*times_path),
-                              times_path->string());
+  return ParseKittiTrajectory(text, path.string(), ReadTextFile(*times_path), times_path->string());
 }
 
 TrajectoryFormat DetectTrajectoryFormat(const std::string& text) {
@@ -239,8 +237,7 @@ std::string FormatTumTrajectory(const Trajectory& trajectory) {
     const Eigen::Quaterniond& q = pose.rotation;
     const Eigen::Vector3d& t = pose.translation;
     out += fmt::format("{:.17g} {:.17g} {:.17g} {:.17g} {:.17g} {:.17g} {:.17g} {:.17g}\n",
-                       trajectory.timestamps[i], t.x(), t.y(), t.z(), q.x(), q.y(), q.z(),
-                       q.w());
+                       trajectory.timestamps[i], t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
   }
   return out;
 }

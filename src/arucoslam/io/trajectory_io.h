@@ -56,9 +56,9 @@ Trajectory ParseKittiTrajectory(const std::string& text, const std::string& sour
 // File readers (throw InputError naming the file when it is missing).
 Trajectory ReadTumTrajectory(const std::filesystem::path& path);
 Trajectory ReadEurocTrajectory(const std::filesystem::path& path);
-Trajectory ReadKittiTrajectory(const std::filesystem::path& path,
-                               const std::optional<std::filesystem::path>& times_path =
-                                   std::nullopt);
+Trajectory ReadKittiTrajectory(
+    const std::filesystem::path& path,
+    const std::optional<std::filesystem::path>& times_path = std::nullopt);
 
 // Guesses the format from the content: a line of 12 numbers is KITTI; a first data line
 // whose timestamp is an integer above 1e15 with comma separators is EuRoC; else TUM.

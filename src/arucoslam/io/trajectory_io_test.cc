@@ -77,13 +77,14 @@ TEST(TrajectoryIo, KittiUsesTimesFileOrIndex) {
   ASSERT_EQ(by_index.size(), 2u);
   EXPECT_EQ(by_index.timestamps[1], 1.0);
   EXPECT_EQ(by_index.poses[1].translation, Eigen::Vector3d(4, 5, 6));
-  EXPECT_NEAR((by_index.poses[1].rotation * Eigen::Vector3d::UnitX() - Eigen::Vector3d::UnitY())
-                  .norm(),
-              0.0, 1e-15);
+  EXPECT_NEAR(
+      (by_index.poses[1].rotation * Eigen::Vector3d::UnitX() - Eigen::Vector3d::UnitY()).norm(),
+      0.0, 1e-15);
   const Trajectory timed = ParseKittiTrajectory(text, "poses.txt", "0.0\n0.25\n", "times.txt");
   EXPECT_EQ(timed.timestamps[1], 0.25);
-  EXPECT_NE(ErrorOf([&] { ParseKittiTrajectory(text, "poses.txt", "0.0\n", "times.txt"); })
-                .find("times.txt: 1 timestamps for 2 poses"),
+  EXPECT_NE(ErrorOf([&] {
+              ParseKittiTrajectory(text, "poses.txt", "0.0\n", "times.txt");
+            }).find("times.txt: 1 timestamps for 2 poses"),
             std::string::npos);
 }
 
@@ -98,23 +99,26 @@ TEST(TrajectoryIo, MalformedLineNamesFileAndLine) {
   EXPECT_EQ(ErrorOf([&] { ParseTumTrajectory(nan, "est.txt"); }),
             "est.txt: line 2: value 'nan' is not finite");
   const std::string backwards = "2 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n";
-  EXPECT_NE(ErrorOf([&] { ParseTumTrajectory(backwards, "est.txt"); })
-                .find("est.txt: line 2: timestamp"),
-            std::string::npos);
+  EXPECT_NE(
+      ErrorOf([&] { ParseTumTrajectory(backwards, "est.txt"); }).find("est.txt: line 2: timestamp"),
+      std::string::npos);
   const std::string zero_quaternion = "1 0 0 0 0 0 0 0\n";
-  EXPECT_NE(ErrorOf([&] { ParseTumTrajectory(zero_quaternion, "est.txt"); })
-                .find("line 1: quaternion norm"),
+  EXPECT_NE(ErrorOf([&] {
+              ParseTumTrajectory(zero_quaternion, "est.txt");
+            }).find("line 1: quaternion norm"),
             std::string::npos);
   EXPECT_EQ(ErrorOf([&] { ParseTumTrajectory("# nothing\n", "est.txt"); }),
             "est.txt: no poses in the file");
   EXPECT_EQ(ErrorOf([&] { ParseEurocTrajectory("#h\n1,2,3\n", "gt.csv"); }),
             "gt.csv: line 2: expected at least 8 numbers (EuRoC: t[ns] px py pz qw qx qy qz "
             "...), found 3");
-  EXPECT_NE(ErrorOf([&] { ParseKittiTrajectory("1 0 0 0 0 1 0 0 0 0 1\n", "k.txt"); })
-                .find("k.txt: line 1: expected 12 numbers"),
+  EXPECT_NE(ErrorOf([&] {
+              ParseKittiTrajectory("1 0 0 0 0 1 0 0 0 0 1\n", "k.txt");
+            }).find("k.txt: line 1: expected 12 numbers"),
             std::string::npos);
-  EXPECT_NE(ErrorOf([&] { ParseKittiTrajectory("2 0 0 0 0 1 0 0 0 0 1 0\n", "k.txt"); })
-                .find("determinant 2"),
+  EXPECT_NE(ErrorOf([&] {
+              ParseKittiTrajectory("2 0 0 0 0 1 0 0 0 0 1 0\n", "k.txt");
+            }).find("determinant 2"),
             std::string::npos);
 }
 
@@ -130,8 +134,9 @@ TEST(TrajectoryIo, RunStatsSchema) {
       ParseRunStats(R"({"tracking": {"losses": 3, "relocalisations": 2}, "other": 1})", "s");
   EXPECT_EQ(stats.losses, 3);
   EXPECT_EQ(stats.relocalisations, 2);
-  EXPECT_EQ(ErrorOf([] { ParseRunStats(R"({"tracking": {"losses": -1, "relocalisations": 0}})",
-                                       "stats.json"); }),
+  EXPECT_EQ(ErrorOf([] {
+              ParseRunStats(R"({"tracking": {"losses": -1, "relocalisations": 0}})", "stats.json");
+            }),
             "stats.json: tracking.losses: expected an integer >= 0");
   EXPECT_EQ(ErrorOf([] { ParseRunStats(R"({"tracking": {"losses": 1}})", "stats.json"); }),
             "stats.json: tracking.relocalisations: missing");

@@ -1,10 +1,9 @@
 #include "arucoslam/markers/camera_locator.h"
 
-#include <opencv2/calib3d.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <opencv2/calib3d.hpp>
 #include <set>
 
 namespace arucoslam {
@@ -72,9 +71,9 @@ Rigid3 Refine(const Correspondences& c, const CameraModel& camera, const Rigid3&
   if (object.size() < 4) return world_from_cam;
   cv::Mat rvec, tvec;
   RvecTvecFromRigid(world_from_cam.Inverse(), rvec, tvec);
-  cv::solvePnPRefineLM(object, image, cv::Mat::eye(3, 3, CV_64F), cv::Mat(), rvec, tvec,
-                       cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT,
-                                        iterations, 1e-12));
+  cv::solvePnPRefineLM(
+      object, image, cv::Mat::eye(3, 3, CV_64F), cv::Mat(), rvec, tvec,
+      cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, iterations, 1e-12));
   return RigidFromRvecTvec(rvec, tvec).Inverse();
 }
 
@@ -113,10 +112,10 @@ std::optional<Rigid3> RansacPnp(const Correspondences& c, const CameraModel& cam
   const double focal = std::max(camera.fx, camera.fy);
   cv::Mat rvec, tvec;
   std::vector<int> inliers;
-  const bool ok = cv::solvePnPRansac(
-      c.in_world, c.normalised, cv::Mat::eye(3, 3, CV_64F), cv::Mat(), rvec, tvec, false,
-      options.ransac_iterations, static_cast<float>(options.inlier_threshold_px / focal),
-      options.ransac_confidence, inliers, cv::SOLVEPNP_SQPNP);
+  const bool ok = cv::solvePnPRansac(c.in_world, c.normalised, cv::Mat::eye(3, 3, CV_64F),
+                                     cv::Mat(), rvec, tvec, false, options.ransac_iterations,
+                                     static_cast<float>(options.inlier_threshold_px / focal),
+                                     options.ransac_confidence, inliers, cv::SOLVEPNP_SQPNP);
   if (!ok) return std::nullopt;
   return RigidFromRvecTvec(rvec, tvec).Inverse();
 }

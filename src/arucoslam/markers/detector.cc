@@ -1,9 +1,8 @@
 #include "arucoslam/markers/detector.h"
 
-#include <opencv2/imgproc.hpp>
-
 #include <algorithm>
 #include <cmath>
+#include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
 #include "arucoslam/markers/dictionary.h"
@@ -27,13 +26,15 @@ bool DetectorOptions::Check() const {
          max_marker_perimeter_rate > min_marker_perimeter_rate &&
          polygonal_approx_accuracy_rate > 0.0 && min_corner_distance_rate >= 0.0 &&
          min_distance_to_border >= 0 && min_marker_distance_rate >= 0.0 &&
-         corner_refinement_win_size >= 1 && corner_refinement_max_iterations >= 1 &&
-         corner_refinement_min_accuracy > 0.0 && perspective_remove_pixel_per_cell >= 1 &&
+         corner_refinement_win_size >= 2 && corner_refinement_window_cells > 0.0 &&
+         corner_refinement_max_iterations >= 1 && corner_refinement_min_accuracy > 0.0 &&
+         perspective_remove_pixel_per_cell >= 1 &&
          perspective_remove_ignored_margin_per_cell >= 0.0 &&
          perspective_remove_ignored_margin_per_cell < 0.5 &&
          max_erroneous_bits_in_border_rate >= 0.0 && min_otsu_std_dev >= 0.0 &&
          error_correction_rate >= 0.0 && error_correction_rate <= 1.0 &&
-         dedup_distance_rate >= 0.0 && marker_border_bits >= 1 && (april_tag_quad_decimate == 0.0 || april_tag_quad_decimate >= 1.0) &&
+         dedup_distance_rate >= 0.0 && marker_border_bits >= 1 &&
+         (april_tag_quad_decimate == 0.0 || april_tag_quad_decimate >= 1.0) &&
          april_tag_quad_sigma >= 0.0;
 }
 
@@ -53,8 +54,8 @@ cv::Ptr<cv::aruco::DetectorParameters> DetectorOptions::ToOpenCv() const {
     case CornerRefinement::kNone:
       p->cornerRefinementMethod = cv::aruco::CORNER_REFINE_NONE;
       break;
-    case CornerRefinement::kSubpix:
-      p->cornerRefinementMethod = cv::aruco::CORNER_REFINE_SUBPIX;
+    case CornerRefinement::kSubpix:  // done per marker after detection (RefineSubpix)
+      p->cornerRefinementMethod = cv::aruco::CORNER_REFINE_NONE;
       break;
     case CornerRefinement::kContour:
       p->cornerRefinementMethod = cv::aruco::CORNER_REFINE_CONTOUR;
@@ -108,6 +109,18 @@ std::vector<MarkerDetection> RemoveDuplicateDetections(std::vector<MarkerDetecti
   return kept;
 }
 
+void MarkerDetector::RefineSubpix(const cv::Mat& gray, std::vector<cv::Point2f>& corners) const {
+  const int cells = dictionary_->markerSize + 2 * options_.marker_border_bits;
+  const double side = 0.25 * cv::arcLength(corners, true);
+  const int half_window = std::clamp(
+      static_cast<int>(std::lround(options_.corner_refinement_window_cells * side / cells)), 2,
+      options_.corner_refinement_win_size);
+  cv::cornerSubPix(gray, corners, cv::Size(half_window, half_window), cv::Size(-1, -1),
+                   cv::TermCriteria(cv::TermCriteria::MAX_ITER | cv::TermCriteria::EPS,
+                                    options_.corner_refinement_max_iterations,
+                                    options_.corner_refinement_min_accuracy));
+}
+
 std::vector<MarkerDetection> MarkerDetector::Detect(const cv::Mat& image) const {
   if (image.empty()) return {};
   cv::Mat gray = image;
@@ -124,6 +137,7 @@ std::vector<MarkerDetection> MarkerDetector::Detect(const cv::Mat& image) const 
   detections.reserve(ids.size());
   for (size_t i = 0; i < ids.size(); ++i) {
     if (corners[i].size() != 4) continue;
+    if (options_.corner_refinement == CornerRefinement::kSubpix) RefineSubpix(gray, corners[i]);
     MarkerDetection detection;
     detection.id = ids[i];
     for (int k = 0; k < 4; ++k) {

@@ -3,10 +3,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <opencv2/aruco.hpp>
 #include <opencv2/core.hpp>
-
-#include <array>
 #include <string>
 #include <vector>
 
@@ -29,27 +28,32 @@ enum class CornerRefinement { kNone, kSubpix, kContour, kAprilTag };
 struct DetectorOptions {
   std::string dictionary = "DICT_4X4_50";  // any name of DictionaryNames()
 
-  int adaptive_thresh_win_size_min = 3;   // pixels, odd window sides tried from min to max
-  int adaptive_thresh_win_size_max = 23;  // pixels
-  int adaptive_thresh_win_size_step = 10;  // pixels
-  double adaptive_thresh_constant = 7.0;   // grey levels subtracted from the local mean
-  double min_marker_perimeter_rate = 0.03;  // of the larger image side
-  double max_marker_perimeter_rate = 4.0;   // of the larger image side
+  int adaptive_thresh_win_size_min = 3;          // pixels, odd window sides tried from min to max
+  int adaptive_thresh_win_size_max = 23;         // pixels
+  int adaptive_thresh_win_size_step = 10;        // pixels
+  double adaptive_thresh_constant = 7.0;         // grey levels subtracted from the local mean
+  double min_marker_perimeter_rate = 0.03;       // of the larger image side
+  double max_marker_perimeter_rate = 4.0;        // of the larger image side
   double polygonal_approx_accuracy_rate = 0.03;  // of the candidate's perimeter
-  double min_corner_distance_rate = 0.05;  // of the candidate's perimeter
-  int min_distance_to_border = 3;          // pixels
+  double min_corner_distance_rate = 0.05;        // of the candidate's perimeter
+  int min_distance_to_border = 3;                // pixels
   // OpenCV's default is 0.05. It is 0 here: OpenCV 4.6 then keeps the outer contour of a
   // narrow white margin over the marker itself (DESIGN.md, known pitfalls); duplicates of
   // one marker are removed afterwards (see dedup_distance_rate).
   double min_marker_distance_rate = 0.0;
   CornerRefinement corner_refinement = CornerRefinement::kSubpix;  // OpenCV default: kNone
-  int corner_refinement_win_size = 5;        // pixels (half window)
+  // kSubpix: cv::cornerSubPix on each corner with a half window of
+  // corner_refinement_window_cells x the marker's cell size, clamped to
+  // [2, corner_refinement_win_size] pixels. A fixed window wider than a cell (OpenCV 4.6's
+  // behaviour) lets small markers' corners jump to inner cell corners (measured: up to 6 px).
+  int corner_refinement_win_size = 5;           // pixels (largest half window)
+  double corner_refinement_window_cells = 0.6;  // fraction of a cell, > 0
   int corner_refinement_max_iterations = 30;
-  double corner_refinement_min_accuracy = 0.1;  // pixels
-  int perspective_remove_pixel_per_cell = 4;     // pixels per cell when decoding
+  double corner_refinement_min_accuracy = 0.1;               // pixels
+  int perspective_remove_pixel_per_cell = 4;                 // pixels per cell when decoding
   double perspective_remove_ignored_margin_per_cell = 0.13;  // fraction of a cell
   double max_erroneous_bits_in_border_rate = 0.35;
-  double min_otsu_std_dev = 5.0;      // grey levels
+  double min_otsu_std_dev = 5.0;       // grey levels
   double error_correction_rate = 0.6;  // fraction of the dictionary's correction capacity
   bool detect_inverted_marker = false;
   int marker_border_bits = 1;  // black border width in cells (2 for Kalibr-style AprilGrids)
@@ -77,6 +81,8 @@ class MarkerDetector {
   const DetectorOptions& options() const { return options_; }
 
  private:
+  void RefineSubpix(const cv::Mat& gray, std::vector<cv::Point2f>& corners) const;
+
   DetectorOptions options_;
   cv::Ptr<cv::aruco::Dictionary> dictionary_;
   cv::Ptr<cv::aruco::DetectorParameters> parameters_;

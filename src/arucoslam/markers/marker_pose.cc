@@ -1,10 +1,9 @@
 #include "arucoslam/markers/marker_pose.h"
 
-#include <opencv2/calib3d.hpp>
-#include <opencv2/core/eigen.hpp>
-
 #include <cmath>
 #include <limits>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
 #include <vector>
 
 namespace arucoslam {
@@ -40,7 +39,8 @@ double MarkerReprojectionRms(const CameraModel& camera, const Rigid3& cam_from_m
                              const std::array<Eigen::Vector2d, 4>& pixels) {
   double sum = 0.0;
   for (int i = 0; i < 4; ++i) {
-    const std::optional<Eigen::Vector2d> projected = camera.Project(cam_from_marker * points_in_marker[i]);
+    const std::optional<Eigen::Vector2d> projected =
+        camera.Project(cam_from_marker * points_in_marker[i]);
     if (!projected) return std::numeric_limits<double>::infinity();
     sum += (*projected - pixels[i]).squaredNorm();
   }
@@ -87,8 +87,8 @@ std::optional<MarkerPose> EstimateMarkerPose(const MarkerDetection& detection, d
     const double best = pose.solutions[0].reprojection_rms_px;
     const double second = pose.solutions[1].reprojection_rms_px;
     pose.error_ratio = second > 0.0 ? best / second : 1.0;
-    pose.ambiguous = pose.error_ratio > options.ambiguity_ratio ||
-                     second < options.min_distinct_error_px;
+    pose.ambiguous =
+        pose.error_ratio > options.ambiguity_ratio || second < options.min_distinct_error_px;
   }
   return pose;
 }

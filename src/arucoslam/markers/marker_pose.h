@@ -17,11 +17,12 @@ struct MarkerPoseOptions {
   // second_error < min_distinct_error_px (both within ordinary corner noise). 0.6 follows
   // the ratio used for planar-target ambiguity in practice; 1 px is several times the
   // sub-pixel corner noise seen on real images.
-  double ambiguity_ratio = 0.6;         // in (0, 1]
-  double min_distinct_error_px = 1.0;   // pixels, >= 0
+  double ambiguity_ratio = 0.6;        // in (0, 1]
+  double min_distinct_error_px = 1.0;  // pixels, >= 0
 
-  bool Check() const { return ambiguity_ratio > 0.0 && ambiguity_ratio <= 1.0 &&
-                              min_distinct_error_px >= 0.0; }
+  bool Check() const {
+    return ambiguity_ratio > 0.0 && ambiguity_ratio <= 1.0 && min_distinct_error_px >= 0.0;
+  }
 };
 
 struct MarkerPoseSolution {

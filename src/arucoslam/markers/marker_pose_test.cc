@@ -2,10 +2,9 @@
 
 #include <gtest/gtest.h>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include <cstdio>
 #include <filesystem>
+#include <opencv2/imgcodecs.hpp>
 #include <random>
 
 namespace arucoslam {
@@ -36,8 +35,8 @@ MarkerDetection Project(const CameraModel& camera, const Rigid3& cam_from_marker
   detection.id = 5;
   const auto corners = SquareCorners(size);
   for (int k = 0; k < 4; ++k) {
-    detection.corners[k] = *camera.Project(cam_from_marker * corners[k]) +
-                           Eigen::Vector2d(noise(rng), noise(rng));
+    detection.corners[k] =
+        *camera.Project(cam_from_marker * corners[k]) + Eigen::Vector2d(noise(rng), noise(rng));
   }
   return detection;
 }
@@ -151,11 +150,12 @@ TEST(MarkerPoseRealTest, Image403MarkerPoseMatchesPeer) {
   const double position_error = (base_from_marker.translation - expected_position).norm();
   const double angle_error_deg =
       RotationAngle(base_from_marker.rotation.inverse() * expected_rotation) * 180.0 / M_PI;
-  std::printf("403: position %.4f %.4f %.4f (error %.4f m), rotation error %.3f deg, "
-              "reprojection %.3f px, ratio %.2f%s\n", base_from_marker.translation.x(),
-              base_from_marker.translation.y(), base_from_marker.translation.z(), position_error,
-              angle_error_deg, pose->Best().reprojection_rms_px, pose->error_ratio,
-              pose->ambiguous ? " ambiguous" : "");
+  std::printf(
+      "403: position %.4f %.4f %.4f (error %.4f m), rotation error %.3f deg, "
+      "reprojection %.3f px, ratio %.2f%s\n",
+      base_from_marker.translation.x(), base_from_marker.translation.y(),
+      base_from_marker.translation.z(), position_error, angle_error_deg,
+      pose->Best().reprojection_rms_px, pose->error_ratio, pose->ambiguous ? " ambiguous" : "");
   EXPECT_LT(position_error, 0.01);
   EXPECT_LT(angle_error_deg, 1.0);
 }

@@ -1,8 +1,7 @@
 #include "arucoslam/markers/preprocess.h"
 
-#include <opencv2/imgproc.hpp>
-
 #include <cmath>
+#include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
 namespace arucoslam {

@@ -15,9 +15,9 @@ struct PreprocessOptions {
   int clahe_tile_grid = 8;        // tiles per image side, >= 1
 
   DenoiseMethod denoise = DenoiseMethod::kNone;
-  double gaussian_sigma_px = 0.8;      // kGaussian: standard deviation, pixels, > 0
-  int bilateral_diameter_px = 5;       // kBilateral: neighbourhood diameter, pixels, >= 3
-  double bilateral_sigma_color = 20.0;  // kBilateral: range sigma, grey levels, > 0
+  double gaussian_sigma_px = 0.8;         // kGaussian: standard deviation, pixels, > 0
+  int bilateral_diameter_px = 5;          // kBilateral: neighbourhood diameter, pixels, >= 3
+  double bilateral_sigma_color = 20.0;    // kBilateral: range sigma, grey levels, > 0
   double bilateral_sigma_space_px = 3.0;  // kBilateral: spatial sigma, pixels, > 0
 
   bool Check() const;

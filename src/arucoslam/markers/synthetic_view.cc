@@ -1,9 +1,8 @@
 #include "arucoslam/markers/synthetic_view.h"
 
-#include <opencv2/imgproc.hpp>
-
 #include <algorithm>
 #include <cmath>
+#include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
 #include "arucoslam/markers/dictionary.h"
@@ -63,9 +62,9 @@ void DrawMarker(const CameraModel& camera, const SyntheticMarker& marker, int su
   std::vector<cv::Point2f> outline;
   for (const Eigen::Vector2d& xy : {Eigen::Vector2d(-1, 1), Eigen::Vector2d(1, 1),
                                     Eigen::Vector2d(1, -1), Eigen::Vector2d(-1, -1)}) {
-    const Eigen::Vector3d p = marker.cam_from_marker * Eigen::Vector3d(
-                                                           xy.x() * (half + margin),
-                                                           xy.y() * (half + margin), 0.0);
+    const Eigen::Vector3d p =
+        marker.cam_from_marker *
+        Eigen::Vector3d(xy.x() * (half + margin), xy.y() * (half + margin), 0.0);
     if (p.z() <= 1e-6) return;
     outline.emplace_back(camera.fx * p.x() / p.z() + camera.cx,
                          camera.fy * p.y() / p.z() + camera.cy);
@@ -78,7 +77,8 @@ void DrawMarker(const CameraModel& camera, const SyntheticMarker& marker, int su
   // Source image at a resolution about twice the projected one (avoids aliasing).
   const int cells = DictionaryFromName(marker.dictionary)->markerSize + 2;
   const double projected_side = supersampling * cv::arcLength(outline, true) / 4.0;
-  const int per_cell = std::clamp(static_cast<int>(std::ceil(2.0 * projected_side / cells)), 4, 200);
+  const int per_cell =
+      std::clamp(static_cast<int>(std::ceil(2.0 * projected_side / cells)), 4, 200);
   MarkerImageOptions image_options;
   image_options.marker_size_px = cells * per_cell;
   image_options.quiet_zone_cells = marker.quiet_zone_cells;
@@ -102,9 +102,9 @@ void DrawMarker(const CameraModel& camera, const SyntheticMarker& marker, int su
   cam_from_plane << r.col(0), r.col(1), marker.cam_from_marker.translation;
   const double s = supersampling;
   Eigen::Matrix3d sub_from_pixel;
-  sub_from_pixel << s, 0.0, s * (0.5 - box.x) - 0.5, 0.0, s, s * (0.5 - box.y) - 0.5, 0.0, 0.0,
-      1.0;
-  const Eigen::Matrix3d h = sub_from_pixel * Intrinsics(camera) * cam_from_plane * plane_from_source;
+  sub_from_pixel << s, 0.0, s * (0.5 - box.x) - 0.5, 0.0, s, s * (0.5 - box.y) - 0.5, 0.0, 0.0, 1.0;
+  const Eigen::Matrix3d h =
+      sub_from_pixel * Intrinsics(camera) * cam_from_plane * plane_from_source;
   cv::Mat h_cv(3, 3, CV_64F);
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) h_cv.at<double>(i, j) = h(i, j);

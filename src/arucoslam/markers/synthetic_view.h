@@ -3,10 +3,9 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <opencv2/core.hpp>
-
 #include <array>
 #include <cstdint>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
@@ -29,12 +28,12 @@ enum class SyntheticBackground { kUniform, kTextured };
 
 struct SyntheticViewOptions {
   SyntheticBackground background = SyntheticBackground::kTextured;
-  double background_mean = 128.0;   // mean grey level of the background, 0..255
-  double texture_contrast = 40.0;   // kTextured: standard deviation of the texture, grey levels
-  double blur_sigma_px = 0.7;       // Gaussian optical blur, pixels (0: none)
-  double noise_sigma = 3.0;         // additive Gaussian sensor noise, grey levels (0: none)
-  int supersampling = 3;            // sub-pixels per pixel side when warping, >= 1
-  std::uint64_t seed = 1;           // texture and noise are deterministic from the seed
+  double background_mean = 128.0;  // mean grey level of the background, 0..255
+  double texture_contrast = 40.0;  // kTextured: standard deviation of the texture, grey levels
+  double blur_sigma_px = 0.7;      // Gaussian optical blur, pixels (0: none)
+  double noise_sigma = 3.0;        // additive Gaussian sensor noise, grey levels (0: none)
+  int supersampling = 3;           // sub-pixels per pixel side when warping, >= 1
+  std::uint64_t seed = 1;          // texture and noise are deterministic from the seed
 
   bool Check() const;
 };

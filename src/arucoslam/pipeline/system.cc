@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "arucoslam/feature/undistort.h"
+#include "arucoslam/util/logging.h"
 
 namespace arucoslam {
 
@@ -57,8 +58,16 @@ bool System::MapperIdle() const {
 
 void System::MapKeyframe(KeyframeId keyframe) {
   const Stopwatch watch;
-  mapper_->ProcessKeyframe(keyframe);
+  const LocalMappingResult r = mapper_->ProcessKeyframe(keyframe);
   const double elapsed = watch.ElapsedMilliseconds();
+  ARUCOSLAM_LOG_DEBUG(
+      "keyframe {}: {} culled, {} new ({:.0f} ms), {} fused ({:.0f} ms), BA {} kf {} pts "
+      "rms {:.2f}->{:.2f} px, {} outliers ({:.0f} ms), {} keyframes culled; {:.0f} ms",
+      keyframe.value, r.num_culled_points, r.num_new_points, r.triangulation_ms,
+      r.num_fused_points, r.fusion_ms, r.bundle_adjustment.num_local_keyframes,
+      r.bundle_adjustment.num_points, r.bundle_adjustment.summary.initial_rms_px,
+      r.bundle_adjustment.summary.final_rms_px, r.bundle_adjustment.num_erased_observations,
+      r.bundle_adjustment_ms, r.num_culled_keyframes, elapsed);
   std::lock_guard lock(stats_mutex_);
   stats_.local_mapping_ms.Add(elapsed);
 }
@@ -123,6 +132,9 @@ void System::Initialize(Frame& frame, FrameReport& report) {
   const InitializationResult result =
       initializer_.Initialize(init_reference_->features, frame.features, camera_);
   report.message = result.message;
+  ARUCOSLAM_LOG_DEBUG("frame {}: initialisation {}: {}", report.index,
+                      result.success ? "succeeded" : InitFailureName(result.failure),
+                      result.message);
   if (!result.success) {
     if (result.failure == InitFailure::kTooFewMatches && enough) init_reference_ = frame;
     return;
@@ -162,6 +174,8 @@ void System::Track(Frame& frame, FrameReport& report) {
     }
     last_state_ = result.state;
     report.message = "tracking lost";
+    ARUCOSLAM_LOG_DEBUG("frame {}: tracking lost ({} keyframes in the map)", report.index,
+                        map_->NumKeyframes());
     if (static_cast<int>(map_->NumKeyframes()) <= options_.reset_max_keyframes) ResetMap();
     return;
   }

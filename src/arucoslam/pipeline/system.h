@@ -37,8 +37,9 @@ struct SystemOptions {
   bool blocking = true;
   int mapper_queue_capacity = 3;  // keyframes waiting for the mapping thread
   // The initialisation reference frame is replaced when the current frame is more than this
-  // many seconds later (a stale reference has too few matches left).
-  double max_initialization_gap_s = 1.0;
+  // many seconds later (a reference is also replaced when too few matches are left). Long
+  // enough for a vehicle that starts from rest to build up parallax.
+  double max_initialization_gap_s = 3.0;
   // Tracking lost while the map holds at most this many keyframes: the map is discarded and
   // initialisation starts over (a young map is cheaper to rebuild than to recover).
   int reset_max_keyframes = 5;

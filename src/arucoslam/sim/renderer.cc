@@ -6,6 +6,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <filesystem>
@@ -17,14 +18,13 @@
 #include "arucoslam/sim/image_effects.h"
 #include "arucoslam/util/error.h"
 #include "arucoslam/util/logging.h"
-#include "arucoslam/util/timing.h"
-#include <cstdio>
-#include <cstdlib>
-#include <ctime>
 
 namespace arucoslam {
 namespace {
 
+// Lighting is evaluated per vertex: the sun term is constant over a flat face (per-surface
+// shading), and the headlight varies slowly; the fragment stage only samples the texture,
+// which keeps the software rasteriser fast.
 constexpr const char* kVertexShader = R"(#version 330 core
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
@@ -33,31 +33,6 @@ layout(location = 3) in vec3 diffuse;
 layout(location = 4) in vec3 ambient;
 uniform mat4 clip_from_world;
 uniform mat4 cam_from_world;
-out vec3 v_position;
-out vec3 v_normal;
-out vec2 v_uv;
-out vec3 v_diffuse;
-out vec3 v_ambient;
-out float v_depth;
-void main() {
-  gl_Position = clip_from_world * vec4(position, 1.0);
-  v_position = position;
-  v_normal = normal;
-  v_uv = uv;
-  v_diffuse = diffuse;
-  v_ambient = ambient;
-  v_depth = (cam_from_world * vec4(position, 1.0)).z;
-}
-)";
-
-constexpr const char* kFragmentShader = R"(#version 330 core
-in vec3 v_position;
-in vec3 v_normal;
-in vec2 v_uv;
-in vec3 v_diffuse;
-in vec3 v_ambient;
-in float v_depth;
-uniform sampler2D albedo;
 uniform vec3 sun_direction;
 uniform vec3 camera_position;
 uniform float ambient_strength;
@@ -65,6 +40,30 @@ uniform float sun_strength;
 uniform float headlight_strength;
 uniform float headlight_range;
 uniform float exposure;
+out vec2 v_uv;
+out vec3 v_light;
+out float v_depth;
+void main() {
+  gl_Position = clip_from_world * vec4(position, 1.0);
+  v_uv = uv;
+  v_depth = (cam_from_world * vec4(position, 1.0)).z;
+  vec3 n = normalize(normal);
+  vec3 to_camera = camera_position - position;
+  float distance = length(to_camera);
+  if (dot(n, to_camera) < 0.0) n = -n;  // two-sided surfaces
+  float sun = max(dot(n, -sun_direction), 0.0);
+  float head = max(dot(n, to_camera / max(distance, 1e-6)), 0.0) /
+               (1.0 + (distance * distance) / (headlight_range * headlight_range));
+  v_light = exposure * (ambient_strength * ambient +
+                        (sun_strength * sun + headlight_strength * head) * diffuse);
+}
+)";
+
+constexpr const char* kFragmentShader = R"(#version 330 core
+in vec2 v_uv;
+in vec3 v_light;
+in float v_depth;
+uniform sampler2D albedo;
 uniform int output_depth;
 layout(location = 0) out vec4 color;
 void main() {
@@ -72,16 +71,7 @@ void main() {
     color = vec4(v_depth, 0.0, 0.0, 1.0);
     return;
   }
-  vec3 n = normalize(v_normal);
-  vec3 to_camera = camera_position - v_position;
-  float distance = length(to_camera);
-  if (dot(n, to_camera) < 0.0) n = -n;  // two-sided surfaces
-  float sun = max(dot(n, -sun_direction), 0.0);
-  float head = max(dot(n, to_camera / max(distance, 1e-6)), 0.0) /
-               (1.0 + (distance * distance) / (headlight_range * headlight_range));
-  vec3 texel = texture(albedo, v_uv).rgb;
-  vec3 light = ambient_strength * v_ambient + (sun_strength * sun + headlight_strength * head) * v_diffuse;
-  color = vec4(texel * light * exposure, 1.0);
+  color = vec4(texture(albedo, v_uv).rgb * v_light, 1.0);
 }
 )";
 
@@ -193,10 +183,17 @@ struct SceneVertex {
   float ambient[3];
 };
 
-struct SceneBatch {
-  std::filesystem::path texture;  // empty: untextured (a white texel)
+// The vertices of one primitive and its bounding sphere (world frame), for culling.
+struct PrimitiveRange {
   GLint first_vertex = 0;
   GLsizei vertex_count = 0;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  double radius = 0.0;
+};
+
+struct SceneBatch {
+  std::filesystem::path texture;  // empty: untextured (a white texel)
+  std::vector<PrimitiveRange> ranges;
 };
 
 struct SceneMesh {
@@ -204,7 +201,12 @@ struct SceneMesh {
   std::vector<SceneBatch> batches;
 };
 
-constexpr int kCylinderSegments = 48;
+// Segments around a cylinder: enough that the polygon deviates from the circle by at most
+// about 2 mm (r (1 - cos(pi / n))), between 12 and 48.
+int CylinderSegments(double radius) {
+  const int n = static_cast<int>(std::ceil(M_PI / std::acos(1.0 - std::min(0.002 / radius, 1.0))));
+  return std::clamp(n, 12, 48);
+}
 
 // Appends the triangles of one primitive (in its shape frame) to `out`.
 class PrimitiveTessellator {
@@ -243,9 +245,10 @@ class PrimitiveTessellator {
 
   void Cylinder() {
     const double r = primitive_.radius(), half = 0.5 * primitive_.size.z();
-    for (int i = 0; i < kCylinderSegments; ++i) {
-      const double u0 = static_cast<double>(i) / kCylinderSegments;
-      const double u1 = static_cast<double>(i + 1) / kCylinderSegments;
+    const int segments = CylinderSegments(r);
+    for (int i = 0; i < segments; ++i) {
+      const double u0 = static_cast<double>(i) / segments;
+      const double u1 = static_cast<double>(i + 1) / segments;
       const Eigen::Vector3d n0(std::cos(2 * M_PI * u0), std::sin(2 * M_PI * u0), 0);
       const Eigen::Vector3d n1(std::cos(2 * M_PI * u1), std::sin(2 * M_PI * u1), 0);
       const Eigen::Vector3d top(0, 0, half), bottom(0, 0, -half);
@@ -292,19 +295,30 @@ class PrimitiveTessellator {
 };
 
 SceneMesh BuildSceneMesh(const WorldModel& world) {
-  std::map<std::filesystem::path, std::vector<SceneVertex>> by_texture;
+  std::map<std::filesystem::path, std::pair<std::vector<SceneVertex>, SceneBatch>> by_texture;
   for (const WorldPrimitive& primitive : world.primitives) {
-    PrimitiveTessellator tessellator(primitive, &by_texture[primitive.texture]);
+    auto& [vertices, batch] = by_texture[primitive.texture];
+    PrimitiveRange range;
+    range.first_vertex = static_cast<GLint>(vertices.size());
+    PrimitiveTessellator tessellator(primitive, &vertices);
     switch (primitive.type) {
       case ShapeType::kBox: tessellator.Box(); break;
       case ShapeType::kPlane: tessellator.Plane(); break;
       case ShapeType::kCylinder: tessellator.Cylinder(); break;
     }
+    range.vertex_count = static_cast<GLsizei>(vertices.size()) - range.first_vertex;
+    range.centre = primitive.world_from_shape.translation;
+    range.radius = 0.5 * primitive.size.norm() + 1e-3;
+    batch.ranges.push_back(range);
   }
   SceneMesh mesh;
-  for (auto& [texture, vertices] : by_texture) {
-    mesh.batches.push_back({texture, static_cast<GLint>(mesh.vertices.size()),
-                            static_cast<GLsizei>(vertices.size())});
+  for (auto& [texture, entry] : by_texture) {
+    auto& [vertices, batch] = entry;
+    batch.texture = texture;
+    for (PrimitiveRange& range : batch.ranges) {
+      range.first_vertex += static_cast<GLint>(mesh.vertices.size());
+    }
+    mesh.batches.push_back(std::move(batch));
     mesh.vertices.insert(mesh.vertices.end(), vertices.begin(), vertices.end());
   }
   return mesh;
@@ -362,7 +376,6 @@ class Renderer::Impl {
   GLuint vertex_buffer_ = 0;
   std::vector<SceneBatch> batches_;       // one per texture, drawn in order
   std::vector<GLuint> textures_;          // parallel to batches_
-  GLsizei total_vertices_ = 0;
   Framebuffer multisample_;               // MSAA colour target
   Framebuffer resolved_;                  // single-sample colour target (read back)
   Framebuffer depth_target_;              // single-sample R32F depth target
@@ -398,8 +411,6 @@ Renderer::Impl::Impl(const WorldModel& world, const CameraModel& camera_in,
                           reinterpret_cast<const void*>(attributes[i].second));
   }
   batches_ = std::move(mesh.batches);
-  total_vertices_ = static_cast<GLsizei>(mesh.vertices.size());
-  if (std::getenv("PROFILE_RENDER")) std::fprintf(stderr, "vertices %d batches %zu\n", total_vertices_, batches_.size());
   for (const SceneBatch& batch : batches_) {
     cv::Mat image;
     if (batch.texture.empty()) {
@@ -464,32 +475,43 @@ void Renderer::Impl::Draw(const Rigid3& world_from_cam, double gain, bool depth_
   glUniform1i(location("albedo"), 0);
   glActiveTexture(GL_TEXTURE0);
   glBindVertexArray(vertex_array_);
-  if (std::getenv("PREPASS")) {
-  // Depth pre-pass: rasterise depth only, then shade each visible pixel once (software
-  // rasterisers pay for every shaded fragment, and racks hide much of the hall).
-  glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-  glDepthFunc(GL_LESS);
-  glDrawArrays(GL_TRIANGLES, 0, total_vertices_);
-  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  glDepthFunc(GL_LEQUAL);
-  glDepthMask(GL_FALSE);
-  }
+  // Frustum culling by bounding spheres: the side planes of the pinhole's view (through
+  // the camera centre, normals pointing inwards) and the near plane, in the camera frame.
+  const double left = (-0.5 - pinhole.cx) / pinhole.fx;
+  const double right = (pinhole.width - 0.5 - pinhole.cx) / pinhole.fx;
+  const double top = (-0.5 - pinhole.cy) / pinhole.fy;
+  const double bottom = (pinhole.height - 0.5 - pinhole.cy) / pinhole.fy;
+  const Eigen::Vector3d planes[4] = {Eigen::Vector3d(1, 0, -left).normalized(),
+                                     Eigen::Vector3d(-1, 0, right).normalized(),
+                                     Eigen::Vector3d(0, 1, -top).normalized(),
+                                     Eigen::Vector3d(0, -1, bottom).normalized()};
+  const Rigid3 cam_from_world_rigid = world_from_cam.Inverse();
+  std::vector<GLint> firsts;
+  std::vector<GLsizei> counts;
   for (std::size_t i = 0; i < batches_.size(); ++i) {
+    firsts.clear();
+    counts.clear();
+    for (const PrimitiveRange& range : batches_[i].ranges) {
+      const Eigen::Vector3d centre = cam_from_world_rigid * range.centre;
+      bool visible = centre.z() + range.radius > options.near_m &&
+                     centre.z() - range.radius < options.far_m;
+      for (int k = 0; k < 4 && visible; ++k) visible = planes[k].dot(centre) > -range.radius;
+      if (!visible && options.frustum_culling) continue;
+      firsts.push_back(range.first_vertex);
+      counts.push_back(range.vertex_count);
+    }
+    if (firsts.empty()) continue;
     glBindTexture(GL_TEXTURE_2D, textures_[i]);
-    glDrawArrays(GL_TRIANGLES, batches_[i].first_vertex, batches_[i].vertex_count);
+    glMultiDrawArrays(GL_TRIANGLES, firsts.data(), counts.data(),
+                      static_cast<GLsizei>(firsts.size()));
   }
-  glDepthMask(GL_TRUE);
-  glDepthFunc(GL_LESS);
 }
 
 cv::Mat Renderer::Impl::DrawColor(const Rigid3& world_from_cam, double gain) {
   const bool multisampled = multisample_.framebuffer != 0;
   glBindFramebuffer(GL_FRAMEBUFFER,
                     multisampled ? multisample_.framebuffer : resolved_.framebuffer);
-  static const bool kProfile = std::getenv("PROFILE_RENDER") != nullptr;
-  struct CpuWatch { double t0 = Now(); static double Now() { timespec ts; clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts); return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6; } double ElapsedMilliseconds() const { return Now() - t0; } void Restart() { t0 = Now(); } } watch;
   Draw(world_from_cam, gain, false);
-  if (kProfile) { glFinish(); std::fprintf(stderr, "draw %.1f ", watch.ElapsedMilliseconds()); watch.Restart(); }
   if (multisampled) {
     glBindFramebuffer(GL_READ_FRAMEBUFFER, multisample_.framebuffer);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolved_.framebuffer);
@@ -498,9 +520,7 @@ cv::Mat Renderer::Impl::DrawColor(const Rigid3& world_from_cam, double gain) {
   }
   glBindFramebuffer(GL_READ_FRAMEBUFFER, resolved_.framebuffer);
   cv::Mat bgra(pinhole.height, pinhole.width, CV_8UC4);
-  if (kProfile) { glFinish(); std::fprintf(stderr, "blit %.1f ", watch.ElapsedMilliseconds()); watch.Restart(); }
   glReadPixels(0, 0, pinhole.width, pinhole.height, GL_BGRA, GL_UNSIGNED_BYTE, bgra.data);
-  if (kProfile) { std::fprintf(stderr, "read %.1f\n", watch.ElapsedMilliseconds()); }
   return bgra;
 }
 

@@ -31,6 +31,7 @@ struct RenderOptions {
   Eigen::Vector3d background{0.7, 0.7, 0.7};  // RGB 0..1 where nothing is drawn
   double near_m = 0.05;          // clipping distances along the optical axis, metres
   double far_m = 200.0;
+  bool frustum_culling = true;   // skip primitives whose bounding sphere is out of view
   bool rgb = false;              // also return the colour image (BGR, 8-bit)
   bool depth = false;            // also return the depth image (z in metres, 32-bit float)
   // Sensor: gain(t) = exposure_gain * (1 + exposure_variation * sin(2 pi t / period)).

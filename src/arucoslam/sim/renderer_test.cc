@@ -273,6 +273,36 @@ TEST_F(RendererTest, DepthEqualsDistanceAlongAxisForAPlane) {
   EXPECT_LT(max_error, 1e-3);  // metres, over depths of about 4.5 to 9 m
 }
 
+TEST_F(RendererTest, FrustumCullingDoesNotChangeTheImage) {
+  // Boxes and cylinders all around the camera, some straddling the edges of the view.
+  std::string models;
+  for (int i = 0; i < 24; ++i) {
+    const double angle = i * 2.0 * M_PI / 24.0;
+    const double distance = 1.0 + 0.4 * (i % 5);
+    const std::string pose = std::to_string(distance * std::cos(angle)) + " " +
+                             std::to_string(distance * std::sin(angle)) + " " +
+                             std::to_string(0.2 * (i % 3)) + " 0 0 " + std::to_string(angle);
+    const std::string geometry = i % 2 == 0 ? "<box><size>0.5 0.3 0.8</size></box>"
+                                            : "<cylinder><radius>0.2</radius><length>1.5</length></cylinder>";
+    const double grey = 0.2 + 0.03 * i;
+    models += Visual("m" + std::to_string(i), pose, geometry,
+                     "<diffuse>" + std::to_string(grey) + " 0.5 0.5 1</diffuse>");
+  }
+  const WorldModel world = LoadWorld(models);
+  RenderOptions culled;
+  RenderOptions unculled;
+  unculled.frustum_culling = false;
+  Renderer a(world, TestCamera(), culled);
+  Renderer b(world, TestCamera(), unculled);
+  for (double yaw = 0.0; yaw < 2.0 * M_PI; yaw += 0.7) {
+    const Rigid3 pose = LookAt({0, 0, 0.3}, {std::cos(yaw), std::sin(yaw), 0.25});
+    const cv::Mat image_a = a.Render(pose).grey;
+    EXPECT_EQ(cv::norm(image_a, b.Render(pose).grey, cv::NORM_INF), 0.0) << "yaw " << yaw;
+    EXPECT_GT(cv::norm(image_a, cv::Mat(image_a.size(), CV_8UC1, cv::Scalar(179)),
+                       cv::NORM_L1) / image_a.total(), 5.0);  // not just background
+  }
+}
+
 TEST_F(RendererTest, NoiseIsSeededAndBlurAverages) {
   const WorldModel world = LoadWorld(Visual(
       "wall", "5 0 0 0 0 0", "<box><size>0.2 1 1</size></box>", "<diffuse>0.1 0.1 0.1 1</diffuse>"));

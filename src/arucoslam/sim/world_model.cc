@@ -1,6 +1,7 @@
 #include "arucoslam/sim/world_model.h"
 
 #include <sdf/Box.hh>
+#include <sdf/Console.hh>
 #include <sdf/Element.hh>
 #include <sdf/Cylinder.hh>
 #include <sdf/Geometry.hh>
@@ -225,6 +226,14 @@ WorldModel BuildWorld(const sdf::Root& root, const sdf::Errors& errors,
   return world;
 }
 
+// libsdformat prints its errors to stderr as well as returning them; while loading, it is
+// kept quiet so that bad input gives the one line of the InputError only.
+class QuietSdfConsole {
+ public:
+  QuietSdfConsole() { sdf::Console::Instance()->SetQuiet(true); }
+  ~QuietSdfConsole() { sdf::Console::Instance()->SetQuiet(false); }
+};
+
 }  // namespace
 
 WorldModel LoadWorldModel(const std::filesystem::path& sdf_path) {
@@ -235,7 +244,11 @@ WorldModel LoadWorldModel(const std::filesystem::path& sdf_path) {
   }
   const fs::path base_dir = fs::absolute(sdf_path).parent_path();
   sdf::Root root;
-  const sdf::Errors errors = root.Load(sdf_path.string(), MakeParserConfig(base_dir));
+  sdf::Errors errors;
+  {
+    QuietSdfConsole quiet;
+    errors = root.Load(sdf_path.string(), MakeParserConfig(base_dir));
+  }
   const fs::path world_file = fs::absolute(sdf_path).lexically_normal();
   WorldModel world = BuildWorld(root, errors, source, base_dir, world_file);
   world.sdf_path = world_file;
@@ -247,7 +260,11 @@ WorldModel LoadWorldModelFromString(const std::string& sdf_text,
                                     const std::string& source) {
   const fs::path dir = fs::absolute(base_dir);
   sdf::Root root;
-  const sdf::Errors errors = root.LoadSdfString(sdf_text, MakeParserConfig(dir));
+  sdf::Errors errors;
+  {
+    QuietSdfConsole quiet;
+    errors = root.LoadSdfString(sdf_text, MakeParserConfig(dir));
+  }
   return BuildWorld(root, errors, source, dir, fs::path());
 }
 

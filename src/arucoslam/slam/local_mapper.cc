@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "arucoslam/util/timing.h"
+
 namespace arucoslam {
 
 bool LocalMapperOptions::Check() const {
@@ -25,15 +27,25 @@ LocalMappingResult LocalMapper::ProcessKeyframe(KeyframeId keyframe) {
   if (!exists) return result;
   ++num_processed_;
   result.processed = true;
+  Stopwatch watch;
   result.num_refreshed_points = RefreshKeyframePoints(keyframe);
   result.num_culled_points = CullRecentPoints();
+  result.culling_ms = watch.ElapsedMilliseconds();
+  watch.Restart();
   result.num_new_points = TriangulateNewPoints(keyframe);
+  result.triangulation_ms = watch.ElapsedMilliseconds();
+  watch.Restart();
   result.num_fused_points = FuseDuplicates(keyframe);
+  result.fusion_ms = watch.ElapsedMilliseconds();
+  watch.Restart();
   if (options_.run_bundle_adjustment && map_.NumKeyframes() > 2) {
     result.bundle_adjustment =
         RunLocalBundleAdjustment(map_, keyframe, options_.bundle_adjustment);
   }
+  result.bundle_adjustment_ms = watch.ElapsedMilliseconds();
+  watch.Restart();
   if (options_.cull_keyframes) result.num_culled_keyframes = CullRedundantKeyframes(keyframe);
+  result.culling_ms += watch.ElapsedMilliseconds();
   return result;
 }
 

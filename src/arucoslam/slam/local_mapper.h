@@ -58,6 +58,11 @@ struct LocalMappingResult {
   int num_fused_points = 0;
   int num_culled_keyframes = 0;
   LocalBundleAdjustmentResult bundle_adjustment;
+  // Wall time of each step, milliseconds.
+  double triangulation_ms = 0.0;
+  double fusion_ms = 0.0;
+  double bundle_adjustment_ms = 0.0;
+  double culling_ms = 0.0;  // points and keyframes
 };
 
 class LocalMapper {

@@ -7,87 +7,44 @@
 #include <random>
 
 #include "arucoslam/slam/keyframe_policy.h"
+#include "arucoslam/slam/synthetic_features.h"
 #include "arucoslam/slam/tracker.h"
 
 namespace arucoslam {
 namespace {
 
-// Points with random descriptors in front of a camera moving along world x (0.05 m per
-// frame); each frame sees the points in its image with 0.3 px noise and 3 flipped descriptor
-// bits, plus 100 distractors. Keypoint i's true point is truth[i] (-1: distractor).
+// Camera moving along world x (0.05 m per frame) through the default synthetic cloud.
 class Scene {
  public:
-  explicit Scene(std::uint32_t seed) : random_(seed) {
-    std::uniform_real_distribution<double> x(-4.0, 6.0), y(-3.0, 3.0), z(4.0, 10.0);
-    for (int j = 0; j < 1200; ++j) {
-      points_.emplace_back(x(random_), y(random_), z(random_));
-      OrbDescriptor d;
-      for (auto& byte : d) byte = static_cast<std::uint8_t>(random_() & 0xff);
-      descriptors_.push_back(d);
-    }
-    camera_.width = 640;
-    camera_.height = 480;
-    camera_.fx = camera_.fy = 500.0;
-    camera_.cx = 319.5;
-    camera_.cy = 239.5;
-  }
+  explicit Scene(std::uint32_t seed) : scene_(TestCamera(), MakeOptions(seed)) {}
 
   Rigid3 CamFromWorld(int t) const {
     return Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.05 * t, 0.0, 0.0)).Inverse();
   }
-
+  // Frame t with its true pose set.
   Frame MakeFrame(int t, std::vector<int>* truth) {
-    const Rigid3 cam_from_world = CamFromWorld(t);
-    std::normal_distribution<double> noise(0.0, 0.3);
-    std::uniform_real_distribution<double> u(20.0, 620.0), v(20.0, 460.0);
-    std::vector<std::pair<Eigen::Vector2d, int>> entries;
-    for (std::size_t j = 0; j < points_.size(); ++j) {
-      const auto pixel = camera_.Project(cam_from_world * points_[j]);
-      if (!pixel || !camera_.InImage(*pixel, 20.0)) continue;
-      entries.emplace_back(*pixel + Eigen::Vector2d(noise(random_), noise(random_)), j);
-    }
-    for (int k = 0; k < 100; ++k) entries.emplace_back(Eigen::Vector2d(u(random_), v(random_)), -1);
-    std::shuffle(entries.begin(), entries.end(), random_);
-    Frame frame;
-    frame.id = FrameId(t);
-    frame.timestamp_s = 0.05 * t;
-    frame.camera = camera_;
-    frame.features.pyramid = ScalePyramid::Make(8, 1.2);
-    frame.features.image_width = camera_.width;
-    frame.features.image_height = camera_.height;
-    frame.features.descriptors = cv::Mat(static_cast<int>(entries.size()), kOrbDescriptorBytes, CV_8U);
-    truth->clear();
-    for (std::size_t i = 0; i < entries.size(); ++i) {
-      const auto& [pixel, j] = entries[i];
-      cv::KeyPoint keypoint(static_cast<float>(pixel.x()), static_cast<float>(pixel.y()), 31.0f, 0.0f);
-      keypoint.octave = 0;
-      frame.features.keypoints.push_back(keypoint);
-      frame.features.undistorted.push_back(camera_.Unproject(pixel));
-      OrbDescriptor d;
-      if (j >= 0) {
-        d = descriptors_[j];
-        for (int flip = 0; flip < 3; ++flip) {
-          const int bit = static_cast<int>(random_() % 256);
-          d[bit / 8] ^= static_cast<std::uint8_t>(1u << (bit % 8));
-        }
-      } else {
-        for (auto& byte : d) byte = static_cast<std::uint8_t>(random_() & 0xff);
-      }
-      std::copy(d.begin(), d.end(), frame.features.descriptors.ptr(static_cast<int>(i)));
-      truth->push_back(j);
-    }
-    frame.ResetMatches();
-    frame.cam_from_world = cam_from_world;
+    Frame frame = scene_.MakeFrame(FrameId(t), 0.05 * t, CamFromWorld(t), truth);
+    frame.cam_from_world = CamFromWorld(t);
     return frame;
   }
-
-  const std::vector<Eigen::Vector3d>& points() const { return points_; }
+  const std::vector<Eigen::Vector3d>& points() const { return scene_.points(); }
 
  private:
-  std::mt19937 random_;
-  CameraModel camera_;
-  std::vector<Eigen::Vector3d> points_;
-  std::vector<OrbDescriptor> descriptors_;
+  static CameraModel TestCamera() {
+    CameraModel camera;
+    camera.width = 640;
+    camera.height = 480;
+    camera.fx = camera.fy = 500.0;
+    camera.cx = 319.5;
+    camera.cy = 239.5;
+    return camera;
+  }
+  static SyntheticFeatureOptions MakeOptions(std::uint32_t seed) {
+    SyntheticFeatureOptions options;
+    options.seed = seed;
+    return options;
+  }
+  SyntheticFeatureScene scene_;
 };
 
 struct SceneKeyframe {

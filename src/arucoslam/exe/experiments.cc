@@ -1,0 +1,129 @@
+#include "arucoslam/exe/experiments.h"
+
+#include <fmt/format.h>
+
+#include <cstdio>
+
+#include "arucoslam/exe/experiments_report.h"
+#include "arucoslam/exe/marker_only_run.h"
+#include "arucoslam/io/dataset_reader.h"
+#include "arucoslam/io/marker_map_json.h"
+#include "arucoslam/io/path_json.h"
+#include "arucoslam/sim/default_camera.h"
+#include "arucoslam/sim/path.h"
+#include "arucoslam/util/error.h"
+#include "arucoslam/util/files.h"
+
+namespace arucoslam {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::vector<TimedPose> RepeatRunPoses(const fs::path& world_dir, double max_seconds) {
+  const PathSpec spec = ReadPathJson(world_dir / "path.json");
+  std::vector<TimedPose> poses = GenerateCameraPath(spec, PathRun::kRepeat);
+  if (max_seconds > 0.0) {
+    while (!poses.empty() && poses.back().time_s > max_seconds) poses.pop_back();
+  }
+  if (poses.size() < 3) throw InputError((world_dir / "path.json").string(), "route too short");
+  return poses;
+}
+
+fs::path RenderSequence(const fs::path& world_dir, const std::vector<TimedPose>& poses,
+                        const fs::path& out, const ExperimentsOptions& options) {
+  RequireFile(world_dir / "world.sdf", "world file");
+  DatasetWriterOptions render = options.render;
+  render.progress = options.progress;
+  if (options.progress) std::fprintf(stderr, "rendering %s\n", out.string().c_str());
+  WriteSimulatedSequence(world_dir / "world.sdf", DefaultSimulatorCamera(), poses, out, render);
+  return out;
+}
+
+EvaluationOptions AbsoluteOptions() {
+  EvaluationOptions options;
+  options.association.max_time_difference = 1e-4;  // same frames: stamps are identical
+  return options;
+}
+
+EvaluationOptions Sim3Options() {
+  EvaluationOptions options = AbsoluteOptions();
+  options.alignment.mode = AlignmentMode::kSim3;
+  return options;
+}
+
+// Evaluates `est` when it has enough poses; otherwise the run keeps a note.
+void Evaluate(const Trajectory& gt, const Trajectory& est, bool with_sim3, ExperimentRun& run) {
+  if (est.size() < 3) {
+    run.note += (run.note.empty() ? "" : "; ") + fmt::format("only {} poses", est.size());
+    return;
+  }
+  run.absolute = EvaluateTrajectory(gt, est, run.label, run.label, AbsoluteOptions());
+  if (with_sim3) run.sim3 = EvaluateTrajectory(gt, est, run.label, run.label, Sim3Options());
+}
+
+ExperimentRun MarkerOnlyRun(const fs::path& sequence, const fs::path& out_dir, bool progress) {
+  ExperimentRun run;
+  run.label = "markers only (no SLAM)";
+  run.sequence = "with markers";
+  const Dataset dataset = Dataset::Open(sequence);
+  const auto markers_path = dataset.markers_path();
+  if (!markers_path) {
+    run.note = "the sequence has no markers.json";
+    return run;
+  }
+  MarkerOnlyOptions options;
+  options.progress = progress;
+  const MarkerOnlyResult result = RunMarkerOnly(dataset, ReadMarkerMapJson(*markers_path), options);
+  run.available = true;
+  run.median_frame_ms = result.detection_ms.Summarize().median;
+  run.note = fmt::format("{} of {} frames see a known marker; {} ambiguous single-marker views left out",
+                         result.frames_with_markers, result.frames, result.ambiguous_skipped);
+  WriteTumTrajectory(out_dir / "markers_only.tum", result.trajectory);
+  Evaluate(dataset.ground_truth(), result.trajectory, /*with_sim3=*/false, run);
+  return run;
+}
+
+ExperimentRun NotBuiltRun(const std::string& label, const std::string& sequence) {
+  ExperimentRun run;
+  run.label = label;
+  run.sequence = sequence;
+  run.note = "not available yet: the keypoint SLAM (`arucoslam run`) is not part of this build";
+  return run;
+}
+
+}  // namespace
+
+ExperimentsResult RunExperiments(const ExperimentsOptions& options) {
+  if (!options.Check()) throw InputError("experiments", "invalid options");
+  RequireDirectory(options.world_dir, "world folder");
+  const std::vector<TimedPose> poses = RepeatRunPoses(options.world_dir, options.max_seconds);
+
+  StagedDirectory staged(options.out_dir);
+  const fs::path with_markers =
+      RenderSequence(options.world_dir, poses, staged.path() / "seq_with_markers", options);
+  std::optional<fs::path> without_markers;
+  if (options.world_without_markers_dir) {
+    without_markers = RenderSequence(*options.world_without_markers_dir, poses,
+                                     staged.path() / "seq_without_markers", options);
+  }
+
+  ExperimentsResult result;
+  result.runs.push_back(NotBuiltRun("1: ArucoSLAM (markers + keypoints)", "with markers"));
+  result.runs.push_back(NotBuiltRun("2: keypoints only, markers in scene", "with markers"));
+  if (without_markers) {
+    result.runs.push_back(NotBuiltRun("3: keypoints only, no markers", "without markers"));
+  } else {
+    ExperimentRun run = NotBuiltRun("3: keypoints only, no markers", "without markers");
+    run.note = "no world without markers was given";
+    result.runs.push_back(run);
+  }
+  result.runs.push_back(MarkerOnlyRun(with_markers, staged.path(), options.progress));
+
+  const Dataset reference = Dataset::Open(with_markers);
+  result.table = FormatExperimentsTable(result.runs);
+  WriteExperimentsReport(reference.ground_truth(), result.runs, result.table, staged.path());
+  staged.Commit();
+  return result;
+}
+
+}  // namespace arucoslam

@@ -1,0 +1,87 @@
+// `arucoslam experiments` and `arucoslam demo`: the paper's three experiments on a world,
+// and the same on the built-in default factory (what `make demo` runs).
+#include <cstdio>
+#include <filesystem>
+
+#include "arucoslam/exe/command.h"
+#include "arucoslam/exe/experiments.h"
+#include "arucoslam/sim/factory_world.h"
+#include "arucoslam/util/error.h"
+#include "arucoslam/util/files.h"
+
+namespace arucoslam {
+namespace {
+
+namespace fs = std::filesystem;
+
+void PrintResult(const ExperimentsResult& result, const fs::path& out_dir) {
+  std::printf("%s\n", result.table.c_str());
+  for (const ExperimentRun& run : result.runs) {
+    std::printf("%s: %s\n", run.label.c_str(), run.note.empty() ? "evaluated" : run.note.c_str());
+  }
+  std::printf("report: %s\n", (out_dir / "report.html").string().c_str());
+}
+
+// The default factory twice from one seed: with markers at the docks and without.
+void WriteDefaultWorlds(std::uint32_t seed, const fs::path& with_markers,
+                        const fs::path& without_markers) {
+  FactoryOptions options;
+  options.seed = seed;
+  options.texture = TextureLevel::kLow;  // the paper's homogeneous environment
+  fs::create_directories(with_markers);
+  WriteFactoryWorld(BuildFactoryWorld(options), with_markers);
+  options.markers = false;
+  fs::create_directories(without_markers);
+  WriteFactoryWorld(BuildFactoryWorld(options), without_markers);
+}
+
+}  // namespace
+
+void AddExperimentsCommand(CLI::App& app, int& exit_status) {
+  auto options = std::make_shared<ExperimentsOptions>();
+  auto without = std::make_shared<std::string>();
+  CLI::App* command = app.add_subcommand(
+      "experiments",
+      "The paper's three experiments on a world (ArucoSLAM; keypoints only with markers in the "
+      "scene; keypoints only without markers): render, run, evaluate, report");
+  command->add_option("--world", options->world_dir, "world folder from `world factory`")->required();
+  command->add_option("--world-without-markers", *without,
+                      "the same world without markers (for experiment 3)");
+  command->add_option("--out", options->out_dir, "output folder (replaced)")->required();
+  command->add_option("--max-seconds", options->max_seconds,
+                      "use only the first seconds of the route (0: all)")
+      ->capture_default_str();
+  command->callback([options, without, &exit_status] {
+    if (!without->empty()) options->world_without_markers_dir = *without;
+    PrintResult(RunExperiments(*options), options->out_dir);
+    exit_status = kExitOk;
+  });
+}
+
+void AddDemoCommand(CLI::App& app, int& exit_status) {
+  auto out = std::make_shared<std::string>("out/demo");
+  auto seed = std::make_shared<std::uint32_t>(1);
+  auto max_seconds = std::make_shared<double>(0.0);
+  CLI::App* command = app.add_subcommand(
+      "demo", "Everything on the built-in default: the factory world, its sequences, the three "
+              "experiments, the table and the report (out/demo/)");
+  command->add_option("--out", *out, "output folder (replaced)")->capture_default_str();
+  command->add_option("--seed", *seed, "seed of the factory")->capture_default_str();
+  command->add_option("--max-seconds", *max_seconds, "use only the first seconds of the route")
+      ->capture_default_str();
+  command->callback([out, seed, max_seconds, &exit_status] {
+    StagedDirectory staged{fs::path(*out)};
+    ExperimentsOptions options;
+    options.world_dir = staged.path() / "world";
+    options.world_without_markers_dir = staged.path() / "world_without_markers";
+    options.out_dir = staged.path() / "experiments";
+    options.max_seconds = *max_seconds;
+    WriteDefaultWorlds(*seed, options.world_dir, *options.world_without_markers_dir);
+    const ExperimentsResult result = RunExperiments(options);
+    staged.Commit();
+    PrintResult(result, fs::path(*out) / "experiments");
+    exit_status = kExitOk;
+  });
+}
+
+}  // namespace arucoslam

@@ -1,0 +1,18 @@
+// The experiments' outputs: the comparison table, the plots of every evaluated run, and a
+// report in Markdown and HTML that shows both, with each run's notes.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "arucoslam/exe/experiments.h"
+#include "arucoslam/io/trajectory_io.h"
+
+namespace arucoslam {
+
+// Writes table.txt, plots (*.svg), report.md and report.html into `dir`.
+void WriteExperimentsReport(const Trajectory& ground_truth, const std::vector<ExperimentRun>& runs,
+                            const std::string& table, const std::filesystem::path& dir);
+
+}  // namespace arucoslam

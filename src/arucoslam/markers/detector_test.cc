@@ -1,0 +1,381 @@
+#include "arucoslam/markers/detector.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <opencv2/imgcodecs.hpp>
+#include <random>
+#include <sstream>
+
+#include "arucoslam/markers/synthetic_view.h"
+#include "arucoslam/util/error.h"
+
+namespace arucoslam {
+namespace {
+
+CameraModel Camera640() {
+  CameraModel camera;
+  camera.width = 640;
+  camera.height = 480;
+  camera.fx = camera.fy = 500.0;
+  camera.cx = 319.5;
+  camera.cy = 239.5;
+  return camera;
+}
+
+// A marker at `depth` metres, tilted by `tilt` radians about a random axis across the
+// view, rolled randomly about its normal, placed randomly but wholly inside the image.
+SyntheticMarker RandomMarker(double depth, double tilt, std::mt19937& rng) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const double azimuth = M_PI * unit(rng);
+  const double roll = M_PI * unit(rng);
+  const Eigen::Matrix3d facing = Eigen::Vector3d(1, -1, -1).asDiagonal();
+  const Eigen::Matrix3d rotation =
+      Eigen::AngleAxisd(tilt, Eigen::Vector3d(std::cos(azimuth), std::sin(azimuth), 0)) * facing *
+      Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitZ());
+  // Keep the marker (with its margin) inside the image: allowed offset in normalised units.
+  const double half_extent = 0.2 * 0.5 * (1.0 + 2.0 * 2.0 / 6.0) * 1.5 / depth;
+  const double max_x = std::max(0.0, 319.0 / 500.0 - half_extent) * 0.9;
+  const double max_y = std::max(0.0, 239.0 / 500.0 - half_extent) * 0.9;
+  SyntheticMarker marker;
+  marker.id = std::uniform_int_distribution<int>(0, 49)(rng);
+  marker.size = 0.2;
+  bool inside = false;
+  while (!inside) {  // the black square wholly in the image, 5 px from its border
+    const Eigen::Vector3d position(depth * max_x * unit(rng), depth * max_y * unit(rng), depth);
+    marker.cam_from_marker = Rigid3(rotation, position);
+    inside = true;
+    for (const Eigen::Vector2d& corner : ProjectMarkerCorners(Camera640(), marker)) {
+      inside = inside && Camera640().InImage(corner, 5.0);
+    }
+  }
+  return marker;
+}
+
+struct Scene {
+  SyntheticViewOptions view;
+  double white_level;
+};
+
+Scene RandomScene(int index, std::mt19937& rng) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  Scene scene;
+  scene.view.seed = 1000 + index;
+  scene.view.blur_sigma_px = 0.5 + 0.7 * unit(rng);
+  scene.view.noise_sigma = 2.0 + 3.0 * unit(rng);
+  switch (index % 4) {
+    case 0:  // textured, mid grey
+      scene.view.background_mean = 128.0;
+      break;
+    case 1:  // darker textured surroundings than the marker's margin (DESIGN.md pitfall)
+      scene.view.background_mean = 60.0;
+      scene.view.texture_contrast = 25.0;
+      break;
+    case 2:  // uniform grey wall
+      scene.view.background = SyntheticBackground::kUniform;
+      scene.view.background_mean = 100.0;
+      break;
+    default:  // bright, high-contrast texture
+      scene.view.background_mean = 160.0;
+      scene.view.texture_contrast = 60.0;
+      break;
+  }
+  scene.white_level = 170.0 + 60.0 * unit(rng);
+  return scene;
+}
+
+// Issue 2 acceptance: recall >= 99% for a 0.2 m marker up to 4 m, 640x480, fx 500, tilted
+// up to 40 degrees; 50 degrees is measured apart (at 4 m the marker is then 25 x 16 px,
+// under 3 px per cell across): measured 93.8% (90/96) there, asserted >= 90%.
+TEST(MarkerDetectorTest, RecallOnWarpedMarkersUpTo4Metres) {
+  const MarkerDetector detector;
+  std::mt19937 rng(42);
+  int trials = 0, false_ids = 0;
+  std::map<double, std::pair<int, int>> found_by_tilt;  // tilt -> (found, trials)
+  std::vector<double> corner_errors;
+  for (const double depth : {0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0}) {
+    for (const double tilt_deg : {0.0, 20.0, 40.0, 50.0}) {
+      for (int repeat = 0; repeat < 12; ++repeat) {
+        const Scene scene = RandomScene(trials, rng);
+        SyntheticMarker marker = RandomMarker(depth, tilt_deg * M_PI / 180.0, rng);
+        marker.white_level = scene.white_level;
+        const cv::Mat image = RenderSyntheticView(Camera640(), {marker}, scene.view);
+        ++trials;
+        bool hit = false;
+        const auto truth = ProjectMarkerCorners(Camera640(), marker);
+        for (const MarkerDetection& d : detector.Detect(image)) {
+          if (d.id != marker.id) {
+            ++false_ids;
+            continue;
+          }
+          hit = true;
+          for (int k = 0; k < 4; ++k) corner_errors.push_back((d.corners[k] - truth[k]).norm());
+        }
+        found_by_tilt[tilt_deg].first += hit;
+        ++found_by_tilt[tilt_deg].second;
+        if (!hit) std::printf("missed: depth %.1f tilt %.0f\n", depth, tilt_deg);
+      }
+    }
+  }
+  int found = 0, counted = 0;
+  for (const auto& [tilt, counts] : found_by_tilt) {
+    std::printf("tilt %2.0f deg: recall %.4f (%d/%d)\n", tilt, counts.first / double(counts.second),
+                counts.first, counts.second);
+    if (tilt <= 40.0) {
+      found += counts.first;
+      counted += counts.second;
+    }
+  }
+  std::sort(corner_errors.begin(), corner_errors.end());
+  const double median = corner_errors[corner_errors.size() / 2];
+  const double p95 = corner_errors[corner_errors.size() * 95 / 100];
+  std::printf(
+      "recall up to 40 deg %.4f (%d/%d), false ids %d, corner error median %.3f px "
+      "p95 %.3f px max %.3f px\n",
+      found / double(counted), found, counted, false_ids, median, p95, corner_errors.back());
+  EXPECT_GE(found / double(counted), 0.99);
+  EXPECT_GE(found_by_tilt[50.0].first / double(found_by_tilt[50.0].second), 0.90);
+  EXPECT_EQ(false_ids, 0);
+  EXPECT_LT(median, 0.3);
+  // No gross corner error (an inner cell corner or the margin would be >= 2 px off).
+  EXPECT_LT(corner_errors.back(), 1.5);
+}
+
+// DESIGN.md pitfall: a 1-cell margin on a darker background must be detected, once
+// (min_marker_distance_rate 0 lets more candidates through; de-duplication keeps one).
+TEST(MarkerDetectorTest, NarrowQuietZoneOverDarkBackground) {
+  SyntheticViewOptions view;
+  view.background = SyntheticBackground::kUniform;
+  view.background_mean = 70.0;
+  int ours = 0, opencv_default = 0, duplicates = 0;
+  DetectorOptions default_options;
+  default_options.min_marker_distance_rate = 0.05;
+  const MarkerDetector detector, detector_opencv_default(default_options);
+  for (int i = 0; i < 8; ++i) {
+    SyntheticMarker marker;
+    marker.id = 3 + i;
+    marker.quiet_zone_cells = 1.0;
+    marker.cam_from_marker = Rigid3(Eigen::Matrix3d(Eigen::Vector3d(1, -1, -1).asDiagonal()),
+                                    Eigen::Vector3d(0.05 * i - 0.2, 0.0, 0.6 + 0.25 * i));
+    view.seed = i + 1;
+    const cv::Mat image = RenderSyntheticView(Camera640(), {marker}, view);
+    const auto ours_found = detector.Detect(image);
+    const auto default_found = detector_opencv_default.Detect(image);
+    ours += std::count_if(ours_found.begin(), ours_found.end(),
+                          [&](const MarkerDetection& d) { return d.id == marker.id; }) > 0;
+    duplicates += std::max<int>(0, static_cast<int>(ours_found.size()) - 1);
+    opencv_default +=
+        std::count_if(default_found.begin(), default_found.end(),
+                      [&](const MarkerDetection& d) { return d.id == marker.id; }) > 0;
+  }
+  std::printf("1-cell margin: ours %d/8, OpenCV default %d/8\n", ours, opencv_default);
+  EXPECT_EQ(ours, 8);
+  EXPECT_EQ(duplicates, 0);
+}
+
+// OpenCV 4.6's AprilTag refinement reports corners in the apriltag library's pixel
+// convention (+0.5 px); the detector shifts them back so every refinement agrees.
+TEST(MarkerDetectorTest, AprilTagRefinementCornersUseOpenCvPixelCentres) {
+  for (const CornerRefinement refinement :
+       {CornerRefinement::kSubpix, CornerRefinement::kAprilTag}) {
+    DetectorOptions options;
+    options.dictionary = "DICT_APRILTAG_36h11";
+    options.corner_refinement = refinement;
+    const MarkerDetector detector(options);
+    Eigen::Vector2d offset = Eigen::Vector2d::Zero();
+    int count = 0;
+    for (int i = 0; i < 10; ++i) {
+      SyntheticMarker marker;
+      marker.dictionary = options.dictionary;
+      marker.id = i;
+      marker.cam_from_marker =
+          Rigid3(Eigen::Matrix3d(Eigen::AngleAxisd(0.3, Eigen::Vector3d(0.6, 0.8, 0)) *
+                                 Eigen::Vector3d(1, -1, -1).asDiagonal() *
+                                 Eigen::AngleAxisd(0.3 * i, Eigen::Vector3d::UnitZ())),
+                 Eigen::Vector3d(0.02 * i - 0.1, 0.05, 0.8 + 0.1 * i));
+      SyntheticViewOptions view;
+      view.seed = i + 1;
+      view.noise_sigma = 1.0;
+      const cv::Mat image = RenderSyntheticView(Camera640(), {marker}, view);
+      const auto truth = ProjectMarkerCorners(Camera640(), marker);
+      for (const MarkerDetection& d : detector.Detect(image)) {
+        for (int k = 0; k < 4; ++k) {
+          offset += d.corners[k] - truth[k];
+          ++count;
+        }
+      }
+    }
+    ASSERT_EQ(count, 40);
+    offset /= count;
+    EXPECT_LT(offset.norm(), 0.15) << "refinement " << static_cast<int>(refinement);
+  }
+}
+
+TEST(MarkerDetectorTest, RemoveDuplicateDetectionsKeepsLargerOfOverlapping) {
+  MarkerDetection outer, inner, other;
+  outer.id = inner.id = 4;
+  other.id = 4;
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Vector2d unit_square[4] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+    outer.corners[k] = Eigen::Vector2d(100, 100) + 20.0 * unit_square[k];
+    inner.corners[k] = Eigen::Vector2d(101, 100) + 16.0 * unit_square[k];
+    other.corners[k] = Eigen::Vector2d(300, 100) + 16.0 * unit_square[k];
+  }
+  const auto kept = RemoveDuplicateDetections({inner, other, outer}, 0.5);
+  ASSERT_EQ(kept.size(), 2u);
+  EXPECT_NEAR(kept[0].Perimeter(), 160.0, 1e-9);  // the outer one, sorted by x
+  EXPECT_NEAR(kept[1].Center().x(), 300.0, 1e-9);
+}
+
+TEST(MarkerDetectorTest, OptionsAreChecked) {
+  DetectorOptions options;
+  EXPECT_TRUE(options.Check());
+  options.adaptive_thresh_win_size_max = 2;
+  EXPECT_FALSE(options.Check());
+  EXPECT_THROW(MarkerDetector{options}, std::invalid_argument);
+  DetectorOptions unknown;
+  unknown.dictionary = "DICT_9X9_7";
+  EXPECT_THROW(MarkerDetector{unknown}, InputError);
+}
+
+std::filesystem::path DataDir(const std::string& set) {
+  return std::filesystem::path(ARUCOSLAM_TEST_DATA_DIR) / set;
+}
+
+// Real photos (github.com/UbiquityRobotics/fiducials, aruco_detect tests): every expected
+// marker found, corners within 0.5 px of the peer's pixels.
+TEST(MarkerDetectorRealTest, FiducialsArucoUnitCorners) {
+  const std::filesystem::path dir = DataDir("fiducials_aruco_unit");
+  if (!std::filesystem::exists(dir / "expected.json")) {
+    GTEST_SKIP() << "test data folder missing: " << dir;
+  }
+  cv::FileStorage expected((dir / "expected.json").string(), cv::FileStorage::READ);
+  ASSERT_TRUE(expected.isOpened());
+  DetectorOptions options;
+  options.dictionary = "DICT_5X5_1000";
+  const MarkerDetector detector(options);
+  int checked = 0;
+  for (const std::string image_name : {"tag_01_d7_14cm.png", "tag_245-246_d7_14cm.png"}) {
+    const cv::Mat image = cv::imread((dir / "images" / image_name).string(), cv::IMREAD_GRAYSCALE);
+    ASSERT_FALSE(image.empty()) << image_name;
+    const std::vector<MarkerDetection> detections = detector.Detect(image);
+    const cv::FileNode corners_node = expected["detections"][image_name]["corners"];
+    ASSERT_FALSE(corners_node.empty());
+    EXPECT_EQ(detections.size(), corners_node.size()) << image_name;
+    for (const cv::FileNode& marker_node : corners_node) {
+      const int id = std::stoi(marker_node.name());
+      const auto it = std::find_if(detections.begin(), detections.end(),
+                                   [id](const MarkerDetection& d) { return d.id == id; });
+      ASSERT_NE(it, detections.end()) << image_name << " id " << id;
+      for (int k = 0; k < 4; ++k) {
+        const Eigen::Vector2d truth(static_cast<double>(marker_node[k][0]),
+                                    static_cast<double>(marker_node[k][1]));
+        const double error = (it->corners[k] - truth).norm();
+        std::printf("%s id %d corner %d: %.3f px\n", image_name.c_str(), id, k, error);
+        EXPECT_LT(error, 0.5) << image_name << " id " << id << " corner " << k;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_EQ(checked, 12);
+}
+
+struct ExpectedTag {
+  int id;
+  std::array<Eigen::Vector2d, 4> corners;
+};
+
+std::vector<ExpectedTag> ReadAprilTagExpectations(const std::filesystem::path& path) {
+  std::vector<ExpectedTag> tags;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
+    for (char& ch : line) {
+      if (ch == ',' || ch == '(' || ch == ')') ch = ' ';
+    }
+    std::istringstream fields(line);
+    ExpectedTag tag;
+    fields >> tag.id;
+    for (auto& corner : tag.corners) fields >> corner.x() >> corner.y();
+    if (fields) tags.push_back(tag);
+  }
+  return tags;
+}
+
+// Every corner of `tag` within `tolerance` px of a distinct corner of `detection`.
+bool CornersMatchAsSets(const ExpectedTag& tag, const MarkerDetection& detection, double tolerance,
+                        double* worst) {
+  *worst = 0.0;
+  for (const Eigen::Vector2d& corner : tag.corners) {
+    double best = 1e9;
+    for (const Eigen::Vector2d& detected : detection.corners)
+      best = std::min(best, (detected - corner).norm());
+    *worst = std::max(*worst, best);
+  }
+  return *worst < tolerance;
+}
+
+// Real photos (github.com/AprilRobotics/apriltag test data), compared as sets within 1 px
+// (the libraries order corners differently). The expectations use the apriltag library's
+// pixel convention (centres at 0.5), so they are shifted by -0.5 px to OpenCV's. OpenCV
+// 4.6's aruco finds only part of these 15-20 px tags (2-2.5 px per cell, JPEG): measured
+// 22 of 47 with the settings below (AprilTag quads, 8 px per cell, 0.25 cell margin),
+// 15 with the AprilTag defaults and none within 1 px with sub-pixel refinement. The test
+// holds that figure and that every detection is a correct one.
+TEST(MarkerDetectorRealTest, AprilTagDetectUnitCorners) {
+  const std::filesystem::path dir = DataDir("apriltag_detect_unit");
+  if (!std::filesystem::exists(dir)) GTEST_SKIP() << "test data folder missing: " << dir;
+  DetectorOptions options;
+  options.dictionary = "DICT_APRILTAG_36h11";
+  options.corner_refinement = CornerRefinement::kAprilTag;
+  options.perspective_remove_pixel_per_cell = 8;
+  options.perspective_remove_ignored_margin_per_cell = 0.25;
+  const MarkerDetector detector(options);
+  int expected_total = 0, matched_total = 0, wrong_total = 0;
+  double worst_total = 0.0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() != ".txt") continue;
+    std::vector<ExpectedTag> tags = ReadAprilTagExpectations(entry.path());
+    for (ExpectedTag& tag : tags) {
+      for (Eigen::Vector2d& corner : tag.corners) corner -= Eigen::Vector2d(0.5, 0.5);
+    }
+    std::filesystem::path image_path = entry.path();
+    image_path.replace_extension(".jpg");
+    const cv::Mat image = cv::imread(image_path.string(), cv::IMREAD_GRAYSCALE);
+    ASSERT_FALSE(image.empty()) << image_path;
+    const std::vector<MarkerDetection> detections = detector.Detect(image);
+    std::vector<bool> used(detections.size(), false);
+    int matched = 0;
+    for (const ExpectedTag& tag : tags) {
+      for (size_t i = 0; i < detections.size(); ++i) {
+        double worst = 0.0;
+        if (used[i] || detections[i].id != tag.id) continue;
+        if (CornersMatchAsSets(tag, detections[i], 1.0, &worst)) {
+          used[i] = true;
+          ++matched;
+          worst_total = std::max(worst_total, worst);
+          break;
+        }
+      }
+    }
+    const int wrong = static_cast<int>(std::count(used.begin(), used.end(), false));
+    std::printf("%s: %zu expected, %d found, %d detections not expected\n",
+                image_path.filename().c_str(), tags.size(), matched, wrong);
+    expected_total += static_cast<int>(tags.size());
+    matched_total += matched;
+    wrong_total += wrong;
+  }
+  std::printf("apriltag: %d of %d found, worst corner %.3f px\n", matched_total, expected_total,
+              worst_total);
+  EXPECT_EQ(expected_total, 47);
+  EXPECT_GE(matched_total, 22);
+  EXPECT_EQ(wrong_total, 0);
+}
+
+}  // namespace
+}  // namespace arucoslam

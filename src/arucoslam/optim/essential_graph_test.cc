@@ -1,0 +1,172 @@
+#include "arucoslam/optim/essential_graph.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "arucoslam/optim/synthetic_loop.h"
+
+namespace arucoslam {
+namespace {
+
+constexpr int kPointsPerKeyframe = 150;  // shared with the next keyframe (strong edge)
+constexpr int kPointsSeenTwoAhead = 40;  // of those, also seen two keyframes ahead (weak)
+
+// A map whose keyframes are the drifted estimate of the synthetic loop. Each keyframe
+// creates points in front of it (its estimate's local scale, as monocular mapping would),
+// seen by it and the next keyframe, some also two ahead. Truth positions kept per point.
+struct LoopMap {
+  SyntheticLoop loop;
+  std::vector<double> local_scales;  // per keyframe
+  Map map;
+  std::vector<KeyframeId> keyframes;
+  std::vector<MapPointId> points;
+  std::vector<Eigen::Vector3d> truth_points;
+};
+
+Keyframe MakeKeyframe(const Rigid3& cam_from_world, int num_keypoints) {
+  Keyframe keyframe;
+  keyframe.camera.width = 640;
+  keyframe.camera.height = 480;
+  keyframe.camera.fx = keyframe.camera.fy = 500.0;
+  keyframe.camera.cx = 319.5;
+  keyframe.camera.cy = 239.5;
+  keyframe.cam_from_world = cam_from_world;
+  keyframe.features.pyramid = ScalePyramid::Make(8, 1.2);
+  for (int i = 0; i < num_keypoints; ++i) {
+    cv::KeyPoint keypoint(100.0f, 100.0f, 31.0f);
+    keypoint.octave = 0;
+    keyframe.features.keypoints.push_back(keypoint);
+    keyframe.features.undistorted.emplace_back(0.0, 0.0);
+  }
+  keyframe.features.descriptors = cv::Mat::zeros(num_keypoints, kOrbDescriptorBytes, CV_8U);
+  keyframe.map_point_ids.assign(num_keypoints, MapPointId());
+  return keyframe;
+}
+
+void Build(LoopMap& scene, const SyntheticLoopOptions& options) {
+  scene.loop = MakeSyntheticLoop(options);
+  const int n = options.num_keyframes;
+  double scale = 1.0;
+  for (int i = 0; i < n; ++i, scale *= options.scale_drift) scene.local_scales.push_back(scale);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  scene.map.Write([&](MapData& data) {
+    for (int i = 0; i < n; ++i) {
+      const Rigid3 estimate(scene.loop.problem.nodes[i].cam_from_world.rotation,
+                            scene.loop.problem.nodes[i].cam_from_world.translation);
+      scene.keyframes.push_back(data.AddKeyframe(MakeKeyframe(estimate, 3 * kPointsPerKeyframe)));
+    }
+    std::vector<int> next_slot(n, 0);
+    for (int i = 0; i < n; ++i) {
+      const Rigid3 estimate_world_from_cam =
+          data.FindKeyframe(scene.keyframes[i])->cam_from_world.Inverse();
+      for (int k = 0; k < kPointsPerKeyframe; ++k) {
+        const double z = 2.0 + 4.0 * unit(random);
+        const Eigen::Vector3d in_cam((unit(random) - 0.5) * z, (unit(random) - 0.5) * z, z);
+        MapPoint point;
+        point.p_in_world = estimate_world_from_cam * (scene.local_scales[i] * in_cam);
+        point.reference_keyframe = scene.keyframes[i];
+        const MapPointId id = data.AddMapPoint(point);
+        scene.points.push_back(id);
+        scene.truth_points.push_back(scene.loop.truth_cam_from_world[i].Inverse() * in_cam);
+        const int last = k < kPointsSeenTwoAhead ? i + 2 : i + 1;
+        for (int j = i; j <= last && j < n; ++j) {
+          EXPECT_TRUE(data.AddObservation(scene.keyframes[j], next_slot[j]++, id));
+        }
+      }
+    }
+  });
+}
+
+double PointRms(const LoopMap& scene) {
+  return scene.map.Read([&](const MapData& data) {
+    double sum = 0.0;
+    for (std::size_t j = 0; j < scene.points.size(); ++j) {
+      sum += (data.FindMapPoint(scene.points[j])->p_in_world - scene.truth_points[j]).squaredNorm();
+    }
+    return std::sqrt(sum / scene.points.size());
+  });
+}
+
+double KeyframeRms(const LoopMap& scene) {
+  return scene.map.Read([&](const MapData& data) {
+    double sum = 0.0;
+    for (std::size_t i = 0; i < scene.keyframes.size(); ++i) {
+      sum += (data.FindKeyframe(scene.keyframes[i])->CameraCenter() -
+              scene.loop.truth_cam_from_world[i].Inverse().translation)
+                 .squaredNorm();
+    }
+    return std::sqrt(sum / scene.keyframes.size());
+  });
+}
+
+TEST(EssentialGraphTest, ClosingTheLoopCorrectsKeyframesAndPoints) {
+  LoopMap scene;
+  Build(scene, {});
+  const LoopConstraint loop{scene.keyframes.back(), scene.keyframes.front(),
+                            scene.loop.problem.edges.back().to_from_from};
+  const double keyframes_before = KeyframeRms(scene);
+  const double points_before = PointRms(scene);
+  // The current keyframe's neighbourhood moved by the loop Sim3 first, as loop closing does.
+  const Sim3 current_corrected =
+      loop.candidate_from_current.Inverse() * Sim3(scene.map.Read([&](const MapData& data) {
+        return data.FindKeyframe(loop.candidate)->cam_from_world;
+      }));
+  const auto corrected = PropagateLoopCorrection(scene.map, loop.current, current_corrected, 5);
+  EXPECT_EQ(corrected.size(), 3u);  // current and its two covisible keyframes
+  const EssentialGraphResult result =
+      OptimizeEssentialGraph(scene.map, loop.candidate, {loop}, corrected);
+  ASSERT_TRUE(result.applied) << result.summary.message;
+  EXPECT_EQ(result.num_keyframes, 40);
+  EXPECT_EQ(result.num_loop_edges, 1);
+  EXPECT_EQ(result.num_tree_edges, 39);         // every keyframe but the first has a parent
+  EXPECT_EQ(result.num_covisibility_edges, 0);  // i-(i+2) share 40 < 100 points
+  EXPECT_EQ(result.num_corrected_points, static_cast<int>(scene.points.size()));
+  const double keyframes_after = KeyframeRms(scene);
+  const double points_after = PointRms(scene);
+  std::printf("keyframe centres RMS %.3f -> %.3f m, points RMS %.3f -> %.3f m\n", keyframes_before,
+              keyframes_after, points_before, points_after);
+  EXPECT_LT(keyframes_after, keyframes_before / 5.0);
+  EXPECT_LT(points_after, points_before / 5.0);
+  EXPECT_EQ(scene.map.Read([](const MapData& data) { return data.CheckInvariants(); }), "");
+}
+
+TEST(EssentialGraphTest, WeakerCovisibilityThresholdAddsEdges) {
+  LoopMap scene;
+  Build(scene, {});
+  EssentialGraphOptions options;
+  options.min_covisibility_weight = 30;
+  const LoopConstraint loop{scene.keyframes.back(), scene.keyframes.front(),
+                            scene.loop.problem.edges.back().to_from_from};
+  const EssentialGraphResult result =
+      OptimizeEssentialGraph(scene.map, loop.candidate, {loop}, {}, {}, options);
+  ASSERT_TRUE(result.applied) << result.summary.message;
+  EXPECT_EQ(result.num_tree_edges + result.num_covisibility_edges, 39 + 38);
+}
+
+TEST(EssentialGraphTest, MarkerPriorsCorrectAMetricMapWithoutALoop) {
+  SyntheticLoopOptions options;
+  options.scale_drift = 1.0;
+  options.scale_in_loop_edge = false;
+  LoopMap scene;
+  Build(scene, options);
+  std::vector<KeyframePosePrior> priors;
+  for (int i = 0; i < 40; i += 10) {
+    priors.push_back({scene.keyframes[i], scene.loop.truth_cam_from_world[i].Inverse(),
+                      100.0 * Matrix6d::Identity()});
+  }
+  EssentialGraphOptions graph_options;
+  graph_options.solver.fix_scale = true;
+  const double before = KeyframeRms(scene);
+  const EssentialGraphResult result =
+      OptimizeEssentialGraph(scene.map, KeyframeId(), {}, {}, priors, graph_options);
+  ASSERT_TRUE(result.applied) << result.summary.message;
+  EXPECT_EQ(result.num_priors, 4);
+  const double after = KeyframeRms(scene);
+  std::printf("metric map with priors: keyframe centres RMS %.3f -> %.3f m\n", before, after);
+  EXPECT_LT(after, before / 5.0);
+}
+
+}  // namespace
+}  // namespace arucoslam

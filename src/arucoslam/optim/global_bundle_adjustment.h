@@ -1,0 +1,61 @@
+// Global bundle adjustment of every keyframe and point of a Map in three steps that let it run
+// in the background: snapshot (read lock), solve (no lock), apply with corrections (write lock).
+#pragma once
+
+#include <vector>
+
+#include "arucoslam/map/map.h"
+#include "arucoslam/optim/bundle_adjustment.h"
+
+namespace arucoslam {
+
+struct GlobalBundleAdjustmentOptions {
+  BundleAdjustmentOptions solver;
+  // The lowest-id keyframes held fixed (gauge). 2 (default) also fixes the scale of a
+  // monocular map (with 1 the scale direction is free and the Schur complement can be
+  // singular); 1 suffices when marker observations fix the scale.
+  int num_fixed_keyframes = 2;
+  // Erase observations the solve flags as outliers; points left with none are erased.
+  bool erase_outliers = true;
+
+  bool Check() const { return solver.Check() && num_fixed_keyframes >= 1; }
+};
+
+// The whole map as a BundleAdjustmentProblem plus the ids behind its indices and the poses
+// before the solve (to carry the correction over to what was added in the meantime).
+struct GlobalBundleAdjustmentSnapshot {
+  BundleAdjustmentProblem problem;
+  std::vector<KeyframeId> keyframe_ids;  // per problem pose
+  std::vector<Rigid3> poses_before;      // per problem pose
+  std::vector<MapPointId> point_ids;     // per problem point
+  std::vector<int> keypoint_indices;     // per observation
+};
+
+struct GlobalBundleAdjustmentResult {
+  bool applied = false;
+  int num_keyframes = 0;
+  int num_points = 0;
+  int num_erased_observations = 0;
+  int num_corrected_keyframes = 0;  // added after the snapshot, moved with their tree ancestor
+  int num_corrected_points = 0;     // idem, moved with their reference keyframe
+  BundleAdjustmentSummary summary;
+};
+
+GlobalBundleAdjustmentSnapshot TakeGlobalSnapshot(const MapData& data,
+                                                  const GlobalBundleAdjustmentOptions& options);
+
+// Writes a solved snapshot back: solved keyframes and points take their new values (even if
+// the map moved them since; stop other optimisers meanwhile); keyframes that are not in the
+// snapshot follow their nearest spanning-tree ancestor that is (world correction
+// T_before^-1 * T_after), points that are not follow their reference keyframe. Entities erased
+// since are skipped. Fills the counters of `result`.
+void ApplyGlobalBundleAdjustment(MapData& data, const GlobalBundleAdjustmentSnapshot& snapshot,
+                                 const GlobalBundleAdjustmentOptions& options,
+                                 GlobalBundleAdjustmentResult* result);
+
+// Snapshot, solve and apply in one call (blocking; run it on a worker thread to keep
+// tracking going: the map's lock is held only for the snapshot and the write-back).
+GlobalBundleAdjustmentResult RunGlobalBundleAdjustment(
+    Map& map, const GlobalBundleAdjustmentOptions& options = {});
+
+}  // namespace arucoslam

@@ -1,0 +1,300 @@
+// The Ceres side of SolveMarkerBundleAdjustment: poses and markers as [qx qy qz qw tx ty tz]
+// blocks on a left SE(3) manifold, analytic keypoint and marker-corner costs.
+#include <ceres/ceres.h>
+
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "arucoslam/markers/marker_pose.h"
+#include "arucoslam/optim/marker_bundle_adjustment.h"
+#include "arucoslam/util/timing.h"
+
+namespace arucoslam {
+namespace {
+
+constexpr int kPoseSize = 7;
+constexpr int kTangentSize = 6;
+using PoseBlock = std::array<double, kPoseSize>;
+
+Rigid3 FromBlock(const double* block) {
+  return Rigid3(Eigen::Quaterniond(block[3], block[0], block[1], block[2]),
+                Eigen::Vector3d(block[4], block[5], block[6]));
+}
+
+PoseBlock ToBlock(const Rigid3& pose) {
+  const Eigen::Quaterniond q = pose.rotation.normalized();
+  return {q.x(), q.y(), q.z(), q.w(), pose.translation.x(), pose.translation.y(),
+          pose.translation.z()};
+}
+
+// x + delta = Exp(delta) * x. Costs report Jacobians w.r.t. delta in the first six ambient
+// columns (the seventh is zero), so PlusJacobian is [I6; 0].
+class LeftSe3Manifold : public ceres::Manifold {
+ public:
+  int AmbientSize() const override { return kPoseSize; }
+  int TangentSize() const override { return kTangentSize; }
+  bool Plus(const double* x, const double* delta, double* x_plus_delta) const override {
+    const PoseBlock result = ToBlock(Rigid3::Exp(Eigen::Map<const Vector6d>(delta)) * FromBlock(x));
+    std::copy(result.begin(), result.end(), x_plus_delta);
+    return true;
+  }
+  bool PlusJacobian(const double* x, double* jacobian) const override {
+    Eigen::Map<Eigen::Matrix<double, kPoseSize, kTangentSize, Eigen::RowMajor>> j(jacobian);
+    j.setZero();
+    j.topRows<kTangentSize>().setIdentity();
+    return true;
+  }
+  bool Minus(const double* y, const double* x, double* y_minus_x) const override {
+    Eigen::Map<Vector6d> tangent(y_minus_x);
+    tangent = (FromBlock(y) * FromBlock(x).Inverse()).Log();
+    return true;
+  }
+  bool MinusJacobian(const double* x, double* jacobian) const override {
+    Eigen::Map<Eigen::Matrix<double, kTangentSize, kPoseSize, Eigen::RowMajor>> j(jacobian);
+    j.setZero();
+    j.leftCols<kTangentSize>().setIdentity();
+    return true;
+  }
+};
+
+// Writes a whitened residual Jacobian (rows x 6) into a rows x 7 row-major Ceres block.
+template <int Rows>
+void WritePoseJacobian(const Eigen::Matrix<double, Rows, 6>& d, double scale, double* out) {
+  Eigen::Map<Eigen::Matrix<double, Rows, kPoseSize, Eigen::RowMajor>> j(out);
+  j.template leftCols<kTangentSize>() = scale * d;
+  j.col(kTangentSize).setZero();
+}
+
+class KeypointCost : public ceres::SizedCostFunction<2, kPoseSize, 3> {
+ public:
+  KeypointCost(const PinholeIntrinsics& intrinsics, const Eigen::Vector2d& pixel, double sigma)
+      : error_(intrinsics, pixel), inverse_sigma_(1.0 / sigma) {}
+  bool Evaluate(const double* const* parameters, double* residuals,
+                double** jacobians) const override {
+    Eigen::Vector2d residual = Eigen::Vector2d::Zero();
+    PoseJacobian d_pose = PoseJacobian::Zero();
+    PointJacobian d_point = PointJacobian::Zero();
+    const bool want = jacobians != nullptr;
+    if (!error_.Evaluate(FromBlock(parameters[0]), Eigen::Map<const Eigen::Vector3d>(parameters[1]),
+                         &residual, want ? &d_pose : nullptr, want ? &d_point : nullptr)) {
+      residual.setZero();  // behind the camera: no information (an outlier after the solve)
+      d_pose.setZero();
+      d_point.setZero();
+    }
+    Eigen::Map<Eigen::Vector2d> whitened(residuals);
+    whitened = inverse_sigma_ * residual;
+    if (want && jacobians[0] != nullptr) WritePoseJacobian<2>(d_pose, inverse_sigma_, jacobians[0]);
+    if (want && jacobians[1] != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> j(jacobians[1]);
+      j = inverse_sigma_ * d_point;
+    }
+    return true;
+  }
+
+ private:
+  ReprojectionError error_;
+  double inverse_sigma_;
+};
+
+class MarkerCornerCost : public ceres::SizedCostFunction<8, kPoseSize, kPoseSize> {
+ public:
+  MarkerCornerCost(const MarkerCornerError& error, double sigma)
+      : error_(error), inverse_sigma_(1.0 / sigma) {}
+  bool Evaluate(const double* const* parameters, double* residuals,
+                double** jacobians) const override {
+    Vector8d residual = Vector8d::Zero();
+    MarkerCornerJacobian d_cam = MarkerCornerJacobian::Zero();
+    MarkerCornerJacobian d_marker = MarkerCornerJacobian::Zero();
+    const bool want = jacobians != nullptr;
+    if (!error_.Evaluate(FromBlock(parameters[0]), FromBlock(parameters[1]), &residual,
+                         want ? &d_cam : nullptr, want ? &d_marker : nullptr)) {
+      residual.setZero();
+      d_cam.setZero();
+      d_marker.setZero();
+    }
+    Eigen::Map<Vector8d> whitened(residuals);
+    whitened = inverse_sigma_ * residual;
+    if (want && jacobians[0] != nullptr) WritePoseJacobian<8>(d_cam, inverse_sigma_, jacobians[0]);
+    if (want && jacobians[1] != nullptr) {
+      WritePoseJacobian<8>(d_marker, inverse_sigma_, jacobians[1]);
+    }
+    return true;
+  }
+
+ private:
+  MarkerCornerError error_;
+  double inverse_sigma_;
+};
+
+// Ceres parameter blocks of a problem; `*_used` says which ones a residual touches.
+struct Blocks {
+  std::vector<PoseBlock> poses, markers;
+  std::vector<std::array<double, 3>> points;
+  std::vector<bool> pose_used, marker_used, point_used;
+
+  explicit Blocks(const MarkerBundleAdjustmentProblem& problem) {
+    for (const auto& pose : problem.keypoints.poses) poses.push_back(ToBlock(pose.cam_from_world));
+    for (const auto& marker : problem.markers) markers.push_back(ToBlock(marker.world_from_marker));
+    for (const auto& point : problem.keypoints.points) {
+      points.push_back({point.p_in_world.x(), point.p_in_world.y(), point.p_in_world.z()});
+    }
+    pose_used.assign(poses.size(), false);
+    marker_used.assign(markers.size(), false);
+    point_used.assign(points.size(), false);
+  }
+
+  void CopyTo(MarkerBundleAdjustmentProblem* problem) const {
+    auto& keypoints = problem->keypoints;
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      if (pose_used[i]) keypoints.poses[i].cam_from_world = FromBlock(poses[i].data());
+    }
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      if (point_used[i]) keypoints.points[i].p_in_world = Eigen::Vector3d(points[i].data());
+    }
+    for (std::size_t i = 0; i < markers.size(); ++i) {
+      if (marker_used[i]) problem->markers[i].world_from_marker = FromBlock(markers[i].data());
+    }
+  }
+};
+
+// Marks a block used on first sight: manifold, constancy.
+void Use(double* block, bool fixed, ceres::Manifold* manifold, std::vector<bool>::reference used,
+         ceres::Problem* ceres_problem) {
+  if (used) return;
+  used = true;
+  if (manifold != nullptr) ceres_problem->SetManifold(block, manifold);
+  if (fixed) ceres_problem->SetParameterBlockConstant(block);
+}
+
+void AddResiduals(const MarkerBundleAdjustmentProblem& problem, ceres::Manifold* manifold,
+                  ceres::LossFunction* keypoint_loss, ceres::LossFunction* marker_loss,
+                  Blocks* blocks, ceres::Problem* ceres_problem) {
+  const auto& keypoints = problem.keypoints;
+  for (const auto& observation : keypoints.observations) {
+    double* pose = blocks->poses[observation.pose_index].data();
+    double* point = blocks->points[observation.point_index].data();
+    ceres_problem->AddResidualBlock(
+        new KeypointCost(keypoints.intrinsics, observation.pixel, observation.sigma_px),
+        keypoint_loss, pose, point);
+    Use(pose, keypoints.poses[observation.pose_index].fixed, manifold,
+        blocks->pose_used[observation.pose_index], ceres_problem);
+    Use(point, keypoints.points[observation.point_index].fixed, nullptr,
+        blocks->point_used[observation.point_index], ceres_problem);
+  }
+  for (const auto& observation : problem.marker_observations) {
+    const auto& marker = problem.markers[observation.marker_index];
+    double* pose = blocks->poses[observation.pose_index].data();
+    double* marker_block = blocks->markers[observation.marker_index].data();
+    const MarkerCornerError error(keypoints.intrinsics, SquareCorners(marker.size),
+                                  observation.corners_px);
+    ceres_problem->AddResidualBlock(new MarkerCornerCost(error, observation.sigma_px), marker_loss,
+                                    pose, marker_block);
+    Use(pose, keypoints.poses[observation.pose_index].fixed, manifold,
+        blocks->pose_used[observation.pose_index], ceres_problem);
+    Use(marker_block, marker.fixed, manifold, blocks->marker_used[observation.marker_index],
+        ceres_problem);
+  }
+}
+
+void FlagOutliers(const MarkerBundleAdjustmentOptions& options,
+                  const MarkerBundleAdjustmentProblem& problem,
+                  MarkerBundleAdjustmentSummary* summary) {
+  const auto& keypoints = problem.keypoints;
+  summary->keypoint_outliers.assign(keypoints.observations.size(), false);
+  for (std::size_t i = 0; i < keypoints.observations.size(); ++i) {
+    const auto& observation = keypoints.observations[i];
+    Eigen::Vector2d residual;
+    const bool in_front = ReprojectionError(keypoints.intrinsics, observation.pixel)
+                              .Evaluate(keypoints.poses[observation.pose_index].cam_from_world,
+                                        keypoints.points[observation.point_index].p_in_world,
+                                        &residual);
+    const double chi2 = residual.squaredNorm() / (observation.sigma_px * observation.sigma_px);
+    summary->keypoint_outliers[i] = !in_front || chi2 > options.solver.chi_square_threshold;
+    summary->num_keypoint_outliers += summary->keypoint_outliers[i] ? 1 : 0;
+  }
+  summary->marker_outliers.assign(problem.marker_observations.size(), false);
+  for (std::size_t i = 0; i < problem.marker_observations.size(); ++i) {
+    const auto& observation = problem.marker_observations[i];
+    const auto& marker = problem.markers[observation.marker_index];
+    Vector8d residual;
+    const bool in_front =
+        MarkerCornerError(keypoints.intrinsics, SquareCorners(marker.size), observation.corners_px)
+            .Evaluate(keypoints.poses[observation.pose_index].cam_from_world,
+                      marker.world_from_marker, &residual);
+    const double chi2 = residual.squaredNorm() / (observation.sigma_px * observation.sigma_px);
+    summary->marker_outliers[i] = !in_front || chi2 > options.marker_chi_square_threshold;
+    summary->num_marker_outliers += summary->marker_outliers[i] ? 1 : 0;
+  }
+}
+
+}  // namespace
+
+MarkerBundleAdjustmentSummary SolveMarkerBundleAdjustment(
+    const MarkerBundleAdjustmentOptions& options, MarkerBundleAdjustmentProblem* problem) {
+  MarkerBundleAdjustmentSummary summary;
+  std::string reason;
+  if (!options.Check()) {
+    summary.message = "invalid options";
+    return summary;
+  }
+  if (!problem->Check(&reason)) {
+    summary.message = reason;
+    return summary;
+  }
+  const Stopwatch stopwatch;
+  summary.initial_keypoint_rms_px = ReprojectionRmsPixels(problem->keypoints);
+  summary.initial_marker_rms_px = MarkerReprojectionRmsPixels(*problem);
+
+  Blocks blocks(*problem);
+  ceres::Problem::Options problem_options;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem ceres_problem(problem_options);
+  LeftSe3Manifold manifold;
+  ceres::HuberLoss keypoint_loss(options.solver.huber_delta_px);
+  ceres::HuberLoss marker_loss(options.marker_huber_delta);
+  AddResiduals(*problem, &manifold, &keypoint_loss, &marker_loss, &blocks, &ceres_problem);
+  summary.num_residual_blocks = ceres_problem.NumResidualBlocks();
+  if (summary.num_residual_blocks == 0) {
+    summary.success = true;
+    summary.message = "no observations";
+    return summary;
+  }
+
+  ceres::Solver::Options solver_options;
+  // Points eliminated first; poses and markers form the reduced camera system.
+  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  for (std::size_t i = 0; i < blocks.points.size(); ++i) {
+    if (blocks.point_used[i]) ordering->AddElementToGroup(blocks.points[i].data(), 0);
+  }
+  for (std::size_t i = 0; i < blocks.poses.size(); ++i) {
+    if (blocks.pose_used[i]) ordering->AddElementToGroup(blocks.poses[i].data(), 1);
+  }
+  for (std::size_t i = 0; i < blocks.markers.size(); ++i) {
+    if (blocks.marker_used[i]) ordering->AddElementToGroup(blocks.markers[i].data(), 1);
+  }
+  const bool has_points = ordering->NumElements() > 0 && ordering->GroupSize(0) > 0;
+  solver_options.linear_solver_type = has_points ? ceres::DENSE_SCHUR : ceres::DENSE_QR;
+  if (has_points) solver_options.linear_solver_ordering = ordering;
+  solver_options.max_num_iterations = options.solver.max_iterations;
+  solver_options.function_tolerance = options.solver.function_tolerance;
+  solver_options.num_threads = options.solver.num_threads;
+  solver_options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary ceres_summary;
+  ceres::Solve(solver_options, &ceres_problem, &ceres_summary);
+
+  summary.success = ceres_summary.IsSolutionUsable();
+  summary.num_iterations = static_cast<int>(ceres_summary.iterations.size()) - 1;
+  summary.initial_cost = ceres_summary.initial_cost;
+  summary.final_cost = ceres_summary.final_cost;
+  summary.message = ceres_summary.message;
+  if (summary.success) blocks.CopyTo(problem);
+  summary.final_keypoint_rms_px = ReprojectionRmsPixels(problem->keypoints);
+  summary.final_marker_rms_px = MarkerReprojectionRmsPixels(*problem);
+  FlagOutliers(options, *problem, &summary);
+  summary.solve_seconds = stopwatch.ElapsedSeconds();
+  return summary;
+}
+
+}  // namespace arucoslam

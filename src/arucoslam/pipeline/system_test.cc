@@ -1,0 +1,153 @@
+#include "arucoslam/pipeline/system.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "arucoslam/geometry/umeyama.h"
+#include "arucoslam/io/dataset_reader.h"
+#include "arucoslam/slam/synthetic_features.h"
+
+namespace arucoslam {
+namespace {
+
+CameraModel TestCamera() {
+  CameraModel camera;
+  camera.width = 640;
+  camera.height = 480;
+  camera.fx = camera.fy = 500.0;
+  camera.cx = 319.5;
+  camera.cy = 239.5;
+  return camera;
+}
+
+// A sideways, slightly weaving and turning camera path (20 Hz); `moving` false holds it still.
+Rigid3 WorldFromCam(int t, bool moving = true) {
+  if (!moving) t = 0;
+  return Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(0.003 * t, Eigen::Vector3d::UnitY())),
+                Eigen::Vector3d(0.03 * t, 0.2 * std::sin(t / 15.0), 0.003 * t));
+}
+
+struct RunResult {
+  std::vector<StampedPose> trajectory;
+  int first_initialised = -1;
+  SystemStats stats;
+  std::size_t num_keyframes = 0;
+  std::string invariants;
+};
+
+RunResult RunSynthetic(bool blocking, int num_frames, bool moving = true) {
+  SyntheticFeatureScene scene(TestCamera());
+  SystemOptions options;
+  options.blocking = blocking;
+  System system(TestCamera(), options);
+  RunResult run;
+  std::vector<int> truth;
+  for (int t = 0; t < num_frames; ++t) {
+    const FrameReport report = system.ProcessFrame(
+        scene.MakeFrame(FrameId(t), 0.05 * t, WorldFromCam(t, moving).Inverse(), &truth));
+    if (report.initialized_map && run.first_initialised < 0) run.first_initialised = t;
+  }
+  system.Finish();
+  run.trajectory = system.Trajectory();
+  run.stats = system.Stats();
+  run.num_keyframes = system.map().NumKeyframes();
+  run.invariants = system.map().Read([](const MapData& data) { return data.CheckInvariants(); });
+  return run;
+}
+
+// RMS position error after Sim(3) alignment, over the frames of the trajectory.
+double AlignedRmsError(const std::vector<StampedPose>& trajectory) {
+  std::vector<Eigen::Vector3d> estimated, truth;
+  for (const StampedPose& pose : trajectory) {
+    estimated.push_back(pose.world_from_cam.translation);
+    truth.push_back(WorldFromCam(static_cast<int>(std::lround(pose.timestamp_s / 0.05))).translation);
+  }
+  const std::optional<Sim3> truth_from_estimate =
+      UmeyamaAlignment(estimated, truth, AlignmentKind::kSimilarity);
+  if (!truth_from_estimate) return 1e9;
+  double sum = 0.0;
+  for (std::size_t i = 0; i < estimated.size(); ++i) {
+    sum += ((*truth_from_estimate) * estimated[i] - truth[i]).squaredNorm();
+  }
+  return std::sqrt(sum / estimated.size());
+}
+
+TEST(System, OptionsCheck) {
+  EXPECT_TRUE(SystemOptions().Check());
+  SystemOptions options;
+  options.mapper_queue_capacity = 0;
+  EXPECT_FALSE(options.Check());
+  EXPECT_THROW(System(TestCamera(), options), std::invalid_argument);
+}
+
+TEST(System, BlockingRunTracksSyntheticSequenceAccurately) {
+  const int num_frames = 80;
+  const RunResult run = RunSynthetic(true, num_frames);
+  ASSERT_GE(run.first_initialised, 1);
+  EXPECT_LE(run.first_initialised, 10);  // half a second
+  const int after_init = num_frames - run.first_initialised;
+  // Both initial frames plus every tracked frame after them have a pose.
+  EXPECT_GE(static_cast<int>(run.trajectory.size()), 0.95 * after_init);
+  EXPECT_EQ(run.stats.num_frames, num_frames);
+  EXPECT_EQ(run.stats.num_losses, 0);
+  EXPECT_EQ(run.stats.num_initializations, 1);
+  EXPECT_GE(run.num_keyframes, 3u);
+  EXPECT_GE(run.stats.local_mapping_ms.Count(), 1u);
+  EXPECT_EQ(run.invariants, "");
+  // The camera travels about 2.4 m; the error bound is 1% of that.
+  EXPECT_LT(AlignedRmsError(run.trajectory), 0.024);
+}
+
+TEST(System, BlockingRunIsDeterministic) {
+  const RunResult a = RunSynthetic(true, 40);
+  const RunResult b = RunSynthetic(true, 40);
+  ASSERT_EQ(a.trajectory.size(), b.trajectory.size());
+  ASSERT_GT(a.trajectory.size(), 20u);
+  for (std::size_t i = 0; i < a.trajectory.size(); ++i) {
+    EXPECT_EQ(a.trajectory[i].timestamp_s, b.trajectory[i].timestamp_s);
+    EXPECT_EQ(a.trajectory[i].world_from_cam.translation, b.trajectory[i].world_from_cam.translation);
+  }
+}
+
+TEST(System, ThreadedRunTracksSyntheticSequence) {
+  const int num_frames = 80;
+  const RunResult run = RunSynthetic(false, num_frames);
+  ASSERT_GE(run.first_initialised, 1);
+  EXPECT_GE(static_cast<int>(run.trajectory.size()), 0.95 * (num_frames - run.first_initialised));
+  EXPECT_EQ(run.invariants, "");
+  EXPECT_LT(AlignedRmsError(run.trajectory), 0.024);
+}
+
+TEST(System, StaticSyntheticCameraNeverInitialises) {
+  const RunResult run = RunSynthetic(true, 30, /*moving=*/false);
+  EXPECT_EQ(run.first_initialised, -1);
+  EXPECT_GT(run.stats.num_initialization_attempts, 20);
+  EXPECT_EQ(run.stats.num_initializations, 0);
+  EXPECT_TRUE(run.trajectory.empty());
+  EXPECT_EQ(run.num_keyframes, 0u);
+}
+
+TEST(System, RealEurocStaticCameraNeverInitialises) {
+  const std::filesystem::path root =
+      std::filesystem::path(ARUCOSLAM_TEST_DATA_DIR) / "euroc_v101_micro";
+  if (!std::filesystem::exists(root)) GTEST_SKIP() << "test data missing: " << root;
+  const Dataset dataset = Dataset::Open(root);
+  System system(dataset.camera());
+  for (std::size_t i = 0; i < dataset.size(); ++i) {
+    const FrameReport report = system.ProcessImage(dataset.LoadImage(i), dataset.frame(i).timestamp_s);
+    EXPECT_FALSE(report.cam_from_world.has_value()) << "frame " << i << ": " << report.message;
+  }
+  system.Finish();
+  const SystemStats stats = system.Stats();
+  EXPECT_EQ(stats.num_frames, static_cast<int>(dataset.size()));
+  EXPECT_GT(stats.num_initialization_attempts, 50);  // it kept trying
+  EXPECT_EQ(stats.num_initializations, 0);
+  EXPECT_EQ(system.map().NumKeyframes(), 0u);
+  EXPECT_TRUE(system.Trajectory().empty());
+  EXPECT_EQ(stats.extraction_ms.Count(), dataset.size());
+}
+
+}  // namespace
+}  // namespace arucoslam

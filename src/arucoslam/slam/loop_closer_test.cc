@@ -1,0 +1,106 @@
+#include "arucoslam/slam/loop_closer.h"
+
+#include <gtest/gtest.h>
+
+#include "arucoslam/slam/synthetic_loop_map.h"
+
+namespace arucoslam {
+namespace {
+
+// The drifted map of the wall loop (slam/synthetic_loop_map.h) in its own Map.
+struct WallLoop {
+  Map map;
+  SyntheticLoopMap scene;
+  std::vector<KeyframeId> keyframes;
+  std::vector<double> local_scales;
+};
+
+void Build(WallLoop& wall, const SyntheticLoopOptions& loop = {}) {
+  SyntheticLoopMapOptions options;
+  options.loop = loop;
+  wall.scene = BuildSyntheticLoopMap(options, &wall.map);
+  wall.keyframes = wall.scene.keyframes;
+  wall.local_scales = wall.scene.local_scales;
+}
+
+double KeyframeRms(const WallLoop& wall) { return KeyframeCentreRms(wall.map, wall.scene); }
+
+TEST(LoopCloserTest, ClosesTheDriftedLoopAndFusesDuplicates) {
+  WallLoop scene;
+  Build(scene);
+  ASSERT_EQ(scene.map.Read([](const MapData& data) { return data.CheckInvariants(); }), "");
+  const std::size_t points_before = scene.map.NumMapPoints();
+  const double rms_before = KeyframeRms(scene);
+  LoopCloser closer(scene.map);
+  const LoopClosureResult result = closer.CloseLoop(scene.keyframes.back(), scene.keyframes[0]);
+  ASSERT_TRUE(result.closed) << result.reason;
+  const double rms_after = KeyframeRms(scene);
+  std::printf(
+      "matches %d, sim3 inliers %d, projected %d, fused %d, scale %.3f; keyframe RMS %.3f -> "
+      "%.3f m\n",
+      result.num_matches, result.num_sim3_inliers, result.num_projected_matches,
+      result.num_fused_points, result.candidate_from_current.scale, rms_before, rms_after);
+  // The last keyframe's local scale is 1.01^39 = 1.474: the loop maps it back by 1 / 1.474.
+  EXPECT_NEAR(result.candidate_from_current.scale, 1.0 / scene.local_scales.back(), 0.02);
+  EXPECT_GE(result.num_sim3_inliers, 50);
+  EXPECT_GT(result.num_fused_points, 100);
+  EXPECT_LT(scene.map.NumMapPoints(), points_before - 100);  // duplicates merged
+  EXPECT_LT(rms_after, rms_before / 5.0);
+  EXPECT_TRUE(closer.global_bundle_adjustment_requested());
+  EXPECT_EQ(closer.closed_loops().size(), 1u);
+  EXPECT_EQ(scene.map.Read([](const MapData& data) { return data.CheckInvariants(); }), "");
+}
+
+// Descriptor matching that keeps only near-identical descriptors (at most 2 differing bits
+// where up to 4 differ) finds part of the overlap; search by projection with the solved Sim3 must
+// find the rest in the current keyframe.
+TEST(LoopCloserTest, SearchByProjectionFindsTheMatchesDescriptorMatchingMissed) {
+  WallLoop scene;
+  Build(scene);
+  LoopCloserOptions options;
+  options.matching.max_distance = 2;
+  LoopCloser closer(scene.map, options);
+  const LoopClosureResult result = closer.CloseLoop(scene.keyframes.back(), scene.keyframes[0]);
+  ASSERT_TRUE(result.closed) << result.reason;
+  std::printf("strict matching: %d matches, %d inliers, %d projected, %d fused\n",
+              result.num_matches, result.num_sim3_inliers, result.num_projected_matches,
+              result.num_fused_points);
+  EXPECT_LT(result.num_matches, 150);  // the full overlap is 178 points
+  EXPECT_GT(result.num_projected_matches, 30);
+  EXPECT_GE(result.num_sim3_inliers + result.num_projected_matches, 170);
+  EXPECT_EQ(scene.map.Read([](const MapData& data) { return data.CheckInvariants(); }), "");
+}
+
+// Markers make the map metric: the loop is rigid and the graph keeps every scale at 1.
+TEST(LoopCloserTest, MetricMapClosesWithARigidTransform) {
+  WallLoop scene;
+  SyntheticLoopOptions options;
+  options.scale_drift = 1.0;
+  Build(scene, options);
+  const double rms_before = KeyframeRms(scene);
+  LoopCloserOptions closer_options;
+  closer_options.metric_map = true;
+  LoopCloser closer(scene.map, closer_options);
+  const LoopClosureResult result = closer.CloseLoop(scene.keyframes.back(), scene.keyframes[0]);
+  ASSERT_TRUE(result.closed) << result.reason;
+  EXPECT_EQ(result.candidate_from_current.scale, 1.0);
+  const double rms_after = KeyframeRms(scene);
+  std::printf("metric map: keyframe RMS %.3f -> %.3f m\n", rms_before, rms_after);
+  EXPECT_LT(rms_after, rms_before / 5.0);
+}
+
+TEST(LoopCloserTest, RejectsKeyframesThatDoNotOverlap) {
+  WallLoop scene;
+  Build(scene);
+  const std::uint64_t version = scene.map.Version();
+  LoopCloser closer(scene.map);
+  // Keyframe 20 looks at the opposite side of the wall.
+  const LoopClosureResult result = closer.CloseLoop(scene.keyframes.back(), scene.keyframes[20]);
+  EXPECT_FALSE(result.closed);
+  EXPECT_FALSE(result.reason.empty());
+  EXPECT_EQ(scene.map.Version(), version);  // nothing written
+  EXPECT_FALSE(closer.global_bundle_adjustment_requested());
+}
+
+}  // namespace
+}  // namespace arucoslam
