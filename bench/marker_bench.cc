@@ -1,5 +1,6 @@
 // Marker pipeline speed: detection per 640x480 and 1280x720 frame (rendered markers over a
-// textured background), IPPE pose per marker, and the camera locator per frame.
+// textured background), with the small-marker options, IPPE pose per marker, and the camera
+// locator per frame.
 #include <benchmark/benchmark.h>
 
 #include <vector>
@@ -53,6 +54,29 @@ void BM_Detect(benchmark::State& state) {
   state.counters["markers"] = static_cast<double>(found);
 }
 BENCHMARK(BM_Detect)->Args({640, 480})->Args({1280, 720})->Unit(benchmark::kMillisecond);
+
+// The small-marker options of DetectorOptions at 640x480: upsample factor x 10 (10: none)
+// and the second decoding of rejected candidates (0 or 1).
+void BM_DetectSmallMarkerOptions(benchmark::State& state) {
+  const cv::Mat image = RenderSyntheticView(Camera(640, 480), Markers(), {});
+  DetectorOptions options;
+  options.upsample = 0.1 * static_cast<double>(state.range(0));
+  options.rescue_rejected = state.range(1) != 0;
+  const MarkerDetector detector(options);
+  size_t found = 0;
+  for (auto _ : state) {
+    const std::vector<MarkerDetection> detections = detector.Detect(image);
+    found = detections.size();
+    benchmark::DoNotOptimize(detections.data());
+  }
+  state.counters["markers"] = static_cast<double>(found);
+}
+BENCHMARK(BM_DetectSmallMarkerOptions)
+    ->Args({10, 1})
+    ->Args({20, 0})
+    ->Args({20, 1})
+    ->Args({30, 0})
+    ->Unit(benchmark::kMillisecond);
 
 void BM_PreprocessClahe(benchmark::State& state) {
   const CameraModel camera = Camera(640, 480);

@@ -2,6 +2,7 @@
 // and without markers, marker bundle adjustment, and the online marker mapper.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <random>
 
 #include "arucoslam/optim/marker_bundle_adjustment.h"
@@ -32,11 +33,10 @@ void BM_MarkerCornerError(benchmark::State& state) {
   const auto& observation = scene.marker_observations.front();
   const auto& marker = scene.markers[observation.marker_index];
   const double h = marker.size / 2;
-  const MarkerCornerError error(
-      scene.keypoints.intrinsics,
-      {Eigen::Vector3d(-h, h, 0), Eigen::Vector3d(h, h, 0), Eigen::Vector3d(h, -h, 0),
-       Eigen::Vector3d(-h, -h, 0)},
-      observation.corners_px);
+  const MarkerCornerError error(scene.keypoints.intrinsics,
+                                {Eigen::Vector3d(-h, h, 0), Eigen::Vector3d(h, h, 0),
+                                 Eigen::Vector3d(h, -h, 0), Eigen::Vector3d(-h, -h, 0)},
+                                observation.corners_px);
   const Rigid3& cam_from_world = scene.keypoints.poses[observation.pose_index].cam_from_world;
   Vector8d residual;
   MarkerCornerJacobian d_cam, d_marker;
@@ -49,14 +49,18 @@ void BM_MarkerCornerError(benchmark::State& state) {
 }
 BENCHMARK(BM_MarkerCornerError)->Arg(0)->Arg(1)->ArgNames({"jacobians"});
 
-// One frame of the scene (the pose with the most marker observations), started 5 cm / 1
-// degree off; range(0) = 1 adds its markers to the keypoints.
+// The pose of the scene that sees the most markers.
+std::size_t BusiestPose(const MarkerBundleAdjustmentProblem& scene) {
+  std::vector<int> counts(scene.keypoints.poses.size(), 0);
+  for (const auto& observation : scene.marker_observations) ++counts[observation.pose_index];
+  return std::max_element(counts.begin(), counts.end()) - counts.begin();
+}
+
+// That frame started 5 cm / 1 degree off; range(0) = 1 adds its markers to the keypoints.
 void BM_PoseOnlyOptimization(benchmark::State& state) {
   const bool with_markers = state.range(0) != 0;
   const MarkerBundleAdjustmentProblem& scene = Scene();
-  std::vector<int> counts(scene.keypoints.poses.size(), 0);
-  for (const auto& observation : scene.marker_observations) ++counts[observation.pose_index];
-  const std::size_t pose = std::max_element(counts.begin(), counts.end()) - counts.begin();
+  const std::size_t pose = BusiestPose(scene);
   std::vector<PoseObservation> keypoints;
   for (const auto& observation : scene.keypoints.observations) {
     if (observation.pose_index != pose) continue;
@@ -79,12 +83,16 @@ void BM_PoseOnlyOptimization(benchmark::State& state) {
   state.counters["keypoints"] = static_cast<double>(keypoints.size());
   state.counters["markers"] = static_cast<double>(markers.size());
 }
-BENCHMARK(BM_PoseOnlyOptimization)->Arg(0)->Arg(1)->ArgNames({"markers"})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_PoseOnlyOptimization)
+    ->Arg(0)
+    ->Arg(1)
+    ->ArgNames({"markers"})
+    ->Unit(benchmark::kMicrosecond);
 
 // Keypoints-only OptimizePose on the same frame, for comparison with the above.
 void BM_PoseOnlyOptimizationBaseline(benchmark::State& state) {
   const MarkerBundleAdjustmentProblem& scene = Scene();
-  const std::size_t pose = scene.marker_observations.front().pose_index;
+  const std::size_t pose = BusiestPose(scene);
   std::vector<PoseObservation> keypoints;
   for (const auto& observation : scene.keypoints.observations) {
     if (observation.pose_index != pose) continue;

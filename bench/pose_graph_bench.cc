@@ -115,6 +115,9 @@ void BM_GlobalBundleAdjustment(benchmark::State& state) {
     const GlobalBundleAdjustmentResult result = RunGlobalBundleAdjustment(map);
     state.counters["points"] = result.num_points;
     state.counters["iterations"] = result.summary.num_iterations;
+    state.PauseTiming();
+    state.counters["rms_after_m"] = KeyframeCentreRms(map, scene);
+    state.ResumeTiming();
   }
 }
 BENCHMARK(BM_GlobalBundleAdjustment)->Unit(benchmark::kMillisecond);

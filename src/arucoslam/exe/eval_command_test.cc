@@ -1,6 +1,8 @@
 // Runs the `arucoslam eval` binary: evo's numbers on its test data, the files it writes,
 // and one clear line with exit status 2 for each kind of bad input.
 #include <gtest/gtest.h>
+
+#include "arucoslam/exe/command_test_util.h"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -17,11 +19,7 @@ namespace fs = std::filesystem;
 
 const fs::path kEvoData = fs::path(ARUCOSLAM_TEST_DATA_DIR) / "evo_testdata";
 
-struct RunResult {
-  int status = -1;
-  std::string out;
-  std::string err;
-};
+using RunResult = testing_util::SplitCommandResult;
 
 class EvalCommandTest : public ::testing::Test {
  protected:
@@ -35,16 +33,7 @@ class EvalCommandTest : public ::testing::Test {
   void TearDown() override { fs::remove_all(folder_); }
 
   RunResult Run(const std::string& arguments) const {
-    const fs::path out = folder_ / "stdout.txt";
-    const fs::path err = folder_ / "stderr.txt";
-    const std::string command = std::string(ARUCOSLAM_BINARY) + " eval " + arguments + " > " +
-                                out.string() + " 2> " + err.string();
-    const int raw = std::system(command.c_str());
-    RunResult result;
-    result.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    result.out = ReadTextFile(out);
-    result.err = ReadTextFile(err);
-    return result;
+    return testing_util::RunArucoslamSplit("eval " + arguments, folder_);
   }
 
   // A small TUM ground truth: 50 poses at 10 Hz from t = 100 s.

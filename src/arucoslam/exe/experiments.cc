@@ -6,6 +6,7 @@
 
 #include "arucoslam/exe/experiments_report.h"
 #include "arucoslam/exe/marker_only_run.h"
+#include "arucoslam/exe/slam_run.h"
 #include "arucoslam/io/dataset_reader.h"
 #include "arucoslam/io/marker_map_json.h"
 #include "arucoslam/io/path_json.h"
@@ -83,11 +84,54 @@ ExperimentRun MarkerOnlyRun(const fs::path& sequence, const fs::path& out_dir, b
   return run;
 }
 
-ExperimentRun NotBuiltRun(const std::string& label, const std::string& sequence) {
+// ArucoSLAM (blocking, deterministic): keypoints and the sequence's known markers.
+ExperimentRun MarkerSlamRun(const fs::path& sequence, const fs::path& out_dir, bool progress) {
+  ExperimentRun run;
+  run.label = "1: ArucoSLAM (markers + keypoints)";
+  run.sequence = "with markers";
+  const Dataset dataset = Dataset::Open(sequence);
+  const auto markers_path = dataset.markers_path();
+  if (!markers_path) {
+    run.note = "the sequence has no markers.json";
+    return run;
+  }
+  SystemOptions options;
+  options.blocking = true;
+  options.marker_map = ReadMarkerMapJson(*markers_path);
+  options.detector.dictionary = options.marker_map->dictionary;
+  if (progress) std::fprintf(stderr, "SLAM, %s\n", run.label.c_str());
+  const SlamRunResult result =
+      RunSlamOnDataset(dataset, sequence.string(), options, /*markers=*/true, out_dir, progress);
+  run.available = true;
+  run.median_frame_ms = result.timing.frame_ms.Summarize().median;
+  run.note = fmt::format(
+      "{} of {} frames with a pose ({} from markers alone), {} losses, {} marker "
+      "relocalisations, {} world alignments, {} keyframes, {} map points",
+      result.stats.frames_tracked, result.stats.frames, result.timing.num_marker_only_poses,
+      result.stats.losses, result.timing.num_marker_relocalizations,
+      result.timing.num_world_alignments, result.stats.keyframes, result.stats.map_points);
+  Evaluate(dataset.ground_truth(), result.trajectory, /*with_sim3=*/true, run);
+  return run;
+}
+
+// Keypoint-only SLAM (blocking, deterministic) on one rendered sequence.
+ExperimentRun KeypointSlamRun(const std::string& label, const std::string& sequence_name,
+                              const fs::path& sequence, const fs::path& out_dir, bool progress) {
   ExperimentRun run;
   run.label = label;
-  run.sequence = sequence;
-  run.note = "not available yet: the keypoint SLAM (`arucoslam run`) is not part of this build";
+  run.sequence = sequence_name;
+  const Dataset dataset = Dataset::Open(sequence);
+  SystemOptions options;
+  options.blocking = true;
+  if (progress) std::fprintf(stderr, "SLAM, %s\n", label.c_str());
+  const SlamRunResult result =
+      RunSlamOnDataset(dataset, sequence.string(), options, /*markers=*/false, out_dir, progress);
+  run.available = true;
+  run.median_frame_ms = result.timing.frame_ms.Summarize().median;
+  run.note = fmt::format("{} of {} frames tracked, {} losses, {} keyframes, {} map points",
+                         result.stats.frames_tracked, result.stats.frames, result.stats.losses,
+                         result.stats.keyframes, result.stats.map_points);
+  Evaluate(dataset.ground_truth(), result.trajectory, /*with_sim3=*/true, run);
   return run;
 }
 
@@ -108,12 +152,20 @@ ExperimentsResult RunExperiments(const ExperimentsOptions& options) {
   }
 
   ExperimentsResult result;
-  result.runs.push_back(NotBuiltRun("1: ArucoSLAM (markers + keypoints)", "with markers"));
-  result.runs.push_back(NotBuiltRun("2: keypoints only, markers in scene", "with markers"));
+  result.runs.push_back(
+      MarkerSlamRun(with_markers, staged.path() / "run1_arucoslam", options.progress));
+  result.runs.push_back(KeypointSlamRun("2: keypoints only, markers in scene", "with markers",
+                                        with_markers, staged.path() / "run2_keypoints_with_markers",
+                                        options.progress));
   if (without_markers) {
-    result.runs.push_back(NotBuiltRun("3: keypoints only, no markers", "without markers"));
+    result.runs.push_back(KeypointSlamRun("3: keypoints only, no markers", "without markers",
+                                          *without_markers,
+                                          staged.path() / "run3_keypoints_without_markers",
+                                          options.progress));
   } else {
-    ExperimentRun run = NotBuiltRun("3: keypoints only, no markers", "without markers");
+    ExperimentRun run;
+    run.label = "3: keypoints only, no markers";
+    run.sequence = "without markers";
     run.note = "no world without markers was given";
     result.runs.push_back(run);
   }

@@ -58,14 +58,6 @@ std::vector<Row> TableRows() {
   };
 }
 
-std::vector<const TrajectoryEvaluation*> EvaluatedRuns(const std::vector<ExperimentRun>& runs) {
-  std::vector<const TrajectoryEvaluation*> evaluations;
-  for (const ExperimentRun& run : runs) {
-    if (run.absolute) evaluations.push_back(&*run.absolute);
-  }
-  return evaluations;
-}
-
 std::string NotesMarkdown(const std::vector<ExperimentRun>& runs) {
   std::string notes;
   for (const ExperimentRun& run : runs) {
@@ -160,15 +152,24 @@ std::string FormatExperimentsTable(const std::vector<ExperimentRun>& runs) {
 void WriteExperimentsReport(const Trajectory& ground_truth, const std::vector<ExperimentRun>& runs,
                             const std::string& table, const std::filesystem::path& dir) {
   WriteTextFileAtomically(dir / "table.txt", table);
-  std::vector<TrajectoryEvaluation> evaluations;
-  for (const TrajectoryEvaluation* evaluation : EvaluatedRuns(runs)) evaluations.push_back(*evaluation);
-  std::vector<std::string> plot_files;
-  if (!evaluations.empty()) {
-    for (const auto& [name, svg] : MakeEvaluationPlots(ground_truth, evaluations)) {
-      WriteTextFileAtomically(dir / name, svg);
-      plot_files.push_back(name);
-    }
+  std::vector<TrajectoryEvaluation> absolute;
+  std::vector<TrajectoryEvaluation> aligned;
+  for (const ExperimentRun& run : runs) {
+    if (run.absolute) absolute.push_back(*run.absolute);
+    if (run.sim3) aligned.push_back(*run.sim3);
   }
+  std::vector<std::string> plot_files;
+  // World frame (what a world-anchored system is judged by), then Sim(3)-aligned.
+  const auto write_plots = [&](const std::vector<TrajectoryEvaluation>& evaluations,
+                               const std::string& prefix) {
+    if (evaluations.empty()) return;
+    for (const auto& [name, svg] : MakeEvaluationPlots(ground_truth, evaluations)) {
+      WriteTextFileAtomically(dir / (prefix + name), svg);
+      plot_files.push_back(prefix + name);
+    }
+  };
+  write_plots(absolute, "world_");
+  write_plots(aligned, "sim3_aligned_");
   std::string markdown = "# ArucoSLAM experiments\n\n" + MarkdownTable(runs) + "\n## Runs\n\n" +
                          NotesMarkdown(runs) + "\n## Plots\n\n";
   for (const std::string& file : plot_files) markdown += "![" + file + "](" + file + ")\n\n";

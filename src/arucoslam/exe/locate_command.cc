@@ -26,6 +26,8 @@ struct LocateArgs {
   bool clahe = false;
   std::string refinement = "subpix";
   double inlier_threshold_px = 3.0;
+  double upsample = 1.0;
+  bool rescue = false;
 };
 
 CornerRefinement RefinementFromName(const std::string& name) {
@@ -117,6 +119,9 @@ int RunLocate(const LocateArgs& args) {
   DetectorOptions detector_options;
   detector_options.dictionary = map.dictionary;
   detector_options.corner_refinement = RefinementFromName(args.refinement);
+  detector_options.upsample = args.upsample;
+  detector_options.rescue_rejected = args.rescue;
+  if (!detector_options.Check()) throw InputError("--upsample", "expected a factor from 1 to 8");
   const MarkerDetector detector(detector_options);
   CameraLocatorOptions locator;
   locator.inlier_threshold_px = args.inlier_threshold_px;
@@ -152,6 +157,12 @@ void AddLocateCommand(CLI::App& app, int& exit_status) {
       ->add_option("--inlier-threshold", args->inlier_threshold_px,
                    "reprojection error of an inlier corner, pixels")
       ->capture_default_str();
+  locate
+      ->add_option("--upsample", args->upsample,
+                   "scale the image up before detection (small markers; 2 doubles the cost)")
+      ->capture_default_str();
+  locate->add_flag("--rescue", args->rescue,
+                   "decode again the candidates OpenCV rejects (small or blurred markers)");
   locate->callback([args, &exit_status] { exit_status = RunLocate(*args); });
 }
 

@@ -1,6 +1,8 @@
 // Runs `arucoslam locate` on rendered and real images and checks its pose, its JSON and how
 // it fails.
 #include <gtest/gtest.h>
+
+#include "arucoslam/exe/command_test_util.h"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -20,11 +22,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct RunResult {
-  int status = -1;
-  std::string out;
-  std::string err;
-};
+using RunResult = testing_util::SplitCommandResult;
 
 class LocateCommandTest : public ::testing::Test {
  protected:
@@ -38,16 +36,7 @@ class LocateCommandTest : public ::testing::Test {
   void TearDown() override { fs::remove_all(folder_); }
 
   RunResult Run(const std::string& arguments) const {
-    const fs::path out = folder_ / "stdout.txt";
-    const fs::path err = folder_ / "stderr.txt";
-    const std::string command = std::string(ARUCOSLAM_BINARY) + " " + arguments + " > " +
-                                out.string() + " 2> " + err.string();
-    const int raw = std::system(command.c_str());
-    RunResult result;
-    result.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    result.out = ReadTextFile(out);
-    result.err = ReadTextFile(err);
-    return result;
+    return testing_util::RunArucoslamSplit(arguments, folder_);
   }
 
   static CameraModel Camera() {

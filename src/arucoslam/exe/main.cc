@@ -1,5 +1,7 @@
 // The `arucoslam` binary: parses the command line, dispatches to a subcommand, and turns
 // bad input into one clear line on stderr with exit status 2.
+#include <glog/logging.h>
+
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -10,6 +12,8 @@
 
 int main(int argc, char** argv) {
   using namespace arucoslam;
+  google::InitGoogleLogging(argv[0]);
+  FLAGS_logtostderr = true;
   CLI::App app{"ArucoSLAM: monocular visual SLAM fused with ArUco fiducial markers"};
   app.set_version_flag("--version", std::string("arucoslam ") + ARUCOSLAM_VERSION);
   app.require_subcommand(1);
@@ -20,6 +24,9 @@ int main(int argc, char** argv) {
     if (!SetLogLevel(log_level)) {
       throw CLI::ValidationError("--log-level", "unknown level '" + log_level + "'");
     }
+    // Ceres' solver warnings (glog) show only when debugging.
+    const bool debugging = log_level == "debug" || log_level == "trace";
+    FLAGS_minloglevel = debugging ? google::GLOG_INFO : google::GLOG_ERROR;
   });
 
   int exit_status = kExitOk;

@@ -8,6 +8,7 @@
 #include "arucoslam/io/calibration.h"
 #include "arucoslam/io/path_json.h"
 #include "arucoslam/sim/dataset_writer.h"
+#include "arucoslam/sim/default_camera.h"
 #include "arucoslam/sim/path.h"
 #include "arucoslam/util/error.h"
 #include "arucoslam/util/files.h"
@@ -26,17 +27,6 @@ struct SimulateArgs {
   bool quiet = false;
 };
 
-// The simulator's default camera: 640x480 pinhole, 460 px focal length, 30 Hz.
-CameraModel DefaultCamera() {
-  CameraModel camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 460.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
-  camera.rate_hz = 30.0;
-  return camera;
-}
 
 void CheckArgs(const SimulateArgs& args) {
   const RenderOptions& render = args.writer.render;
@@ -65,7 +55,7 @@ void RunSimulate(SimulateArgs args) {
   }
   RequireFile(args.world, "world SDF file");
   const PathSpec spec = ReadPathJson(args.path);
-  CameraModel camera = args.camera.empty() ? DefaultCamera() : ReadCameraModel(args.camera);
+  CameraModel camera = args.camera.empty() ? DefaultSimulatorCamera() : ReadCameraModel(args.camera);
   camera.rate_hz = spec.options.camera_rate_hz;  // the path samples poses at this rate
   std::vector<TimedPose> poses =
       GenerateCameraPath(spec, args.run == "teach" ? PathRun::kTeach : PathRun::kRepeat);

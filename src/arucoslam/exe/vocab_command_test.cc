@@ -1,4 +1,6 @@
 #include <gtest/gtest.h>
+
+#include "arucoslam/exe/command_test_util.h"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -17,22 +19,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int status = -1;
-  std::string output;  // stdout and stderr
-};
-
-Result RunArucoslam(const std::string& arguments) {
-  const std::string command = std::string(ARUCOSLAM_BINARY) + " " + arguments + " 2>&1";
-  Result result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return result;
-  std::array<char, 512> buffer{};
-  while (fgets(buffer.data(), buffer.size(), pipe) != nullptr) result.output += buffer.data();
-  const int status = pclose(pipe);
-  result.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
+using testing_util::RunArucoslam;
 
 int CountLines(const std::string& text) {
   return static_cast<int>(std::count(text.begin(), text.end(), '\n'));
@@ -65,7 +52,7 @@ class VocabCommandTest : public ::testing::Test {
 
 TEST_F(VocabCommandTest, TrainsFromAFolderAndInfoDescribesIt) {
   const fs::path out = dir_ / "vocab.bin";
-  const Result result = RunArucoslam("vocab train --quiet --images " + (dir_ / "images").string() +
+  const auto result = RunArucoslam("vocab train --quiet --images " + (dir_ / "images").string() +
                                      " --out " + out.string() +
                                      " --k 5 --levels 3 --max-features-per-image 300");
   ASSERT_EQ(result.status, 0) << result.output;
@@ -78,7 +65,7 @@ TEST_F(VocabCommandTest, TrainsFromAFolderAndInfoDescribesIt) {
   EXPECT_GT(vocabulary.num_words(), 60u);  // ~1800 features fill most of the 125 leaves
   EXPECT_LE(vocabulary.num_words(), 125u);
 
-  const Result info = RunArucoslam("vocab info --vocab " + out.string());
+  const auto info = RunArucoslam("vocab info --vocab " + out.string());
   ASSERT_EQ(info.status, 0) << info.output;
   EXPECT_NE(info.output.find(std::to_string(vocabulary.num_words()) + " words"),
             std::string::npos)
@@ -88,7 +75,7 @@ TEST_F(VocabCommandTest, TrainsFromAFolderAndInfoDescribesIt) {
 TEST_F(VocabCommandTest, ListFileStrideAndMaxImages) {
   std::ofstream(dir_ / "list.txt") << "# training set\nimages/sub\n\nimages/frame_0.png\n";
   const fs::path out = dir_ / "from_list.bin";
-  Result result = RunArucoslam("vocab train --quiet --images " + (dir_ / "list.txt").string() +
+  auto result = RunArucoslam("vocab train --quiet --images " + (dir_ / "list.txt").string() +
                                " --out " + out.string() + " --k 4 --levels 2");
   ASSERT_EQ(result.status, 0) << result.output;
   EXPECT_EQ(Vocabulary::Load(out).num_training_images(), 3u);
@@ -108,14 +95,14 @@ TEST_F(VocabCommandTest, BadInputIsOneLineAndWritesNothing) {
         "vocab train" + images + " --out " + out.string() + " --max-features-per-image 5",
         "vocab train --images " + (dir_ / "images" / "notes.txt").string() + " --out " +
             out.string()}) {
-    const Result result = RunArucoslam(arguments);
+    const auto result = RunArucoslam(arguments);
     EXPECT_EQ(result.status, 2) << arguments << "\n" << result.output;
     EXPECT_EQ(CountLines(result.output), 1) << result.output;
     EXPECT_FALSE(fs::exists(out)) << arguments;
   }
   // A truncated vocabulary file.
   std::ofstream(dir_ / "short.bin", std::ios::binary) << "ASLAMBOW\x01\x00";
-  const Result info = RunArucoslam("vocab info --vocab " + (dir_ / "short.bin").string());
+  const auto info = RunArucoslam("vocab info --vocab " + (dir_ / "short.bin").string());
   EXPECT_EQ(info.status, 2);
   EXPECT_NE(info.output.find("truncated"), std::string::npos) << info.output;
 }

@@ -1,4 +1,6 @@
 #include <gtest/gtest.h>
+
+#include "arucoslam/exe/command_test_util.h"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -16,22 +18,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int status = -1;
-  std::string output;  // stdout and stderr
-};
-
-Result RunArucoslam(const std::string& arguments) {
-  const std::string command = std::string(ARUCOSLAM_BINARY) + " " + arguments + " 2>&1";
-  Result result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return result;
-  std::array<char, 512> buffer{};
-  while (fgets(buffer.data(), buffer.size(), pipe) != nullptr) result.output += buffer.data();
-  const int status = pclose(pipe);
-  result.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
+using testing_util::RunArucoslam;
 
 class WorldCommandTest : public ::testing::Test {
  protected:
@@ -46,7 +33,7 @@ class WorldCommandTest : public ::testing::Test {
 
 TEST_F(WorldCommandTest, WritesTheFactoryFolder) {
   const fs::path out = dir_ / "factory";
-  const Result result = RunArucoslam(
+  const auto result = RunArucoslam(
       "world factory --seed 3 --aisles 2 --aisle-length 12 --texture low "
       "--markers-per-dock 2 --marker-size 0.25 --out " +
       out.string());
@@ -68,7 +55,7 @@ TEST_F(WorldCommandTest, WritesTheFactoryFolder) {
 
 TEST_F(WorldCommandTest, MarkersOffWritesAnEmptyMap) {
   const fs::path out = dir_ / "bare";
-  const Result result = RunArucoslam(
+  const auto result = RunArucoslam(
       "world factory --seed 1 --aisles 1 --aisle-length 8 --markers off --out " + out.string());
   ASSERT_EQ(result.status, 0) << result.output;
   EXPECT_TRUE(ReadMarkerMapJson(out / "markers.json").markers.empty());
@@ -81,7 +68,7 @@ TEST_F(WorldCommandTest, BadInputIsOneLineAndWritesNothing) {
        {std::string("--texture shiny"), std::string("--markers maybe"), std::string("--aisles 0"),
         std::string("--aisle-length 100"), std::string("--dictionary DICT_9X9_1"),
         std::string("--aisles 8 --markers-per-dock 4"), std::string("--camera-height 1.5")}) {
-    const Result result =
+    const auto result =
         RunArucoslam("world factory --seed 1 " + arguments + " --out " + out.string());
     EXPECT_EQ(result.status, 2) << arguments << ": " << result.output;
     EXPECT_EQ(result.output.rfind("arucoslam: ", 0), 0u) << result.output;

@@ -35,7 +35,7 @@ bool DetectorOptions::Check() const {
          error_correction_rate >= 0.0 && error_correction_rate <= 1.0 &&
          dedup_distance_rate >= 0.0 && marker_border_bits >= 1 &&
          (april_tag_quad_decimate == 0.0 || april_tag_quad_decimate >= 1.0) &&
-         april_tag_quad_sigma >= 0.0;
+         april_tag_quad_sigma >= 0.0 && upsample >= 1.0 && upsample <= 8.0 && rescue.Check();
 }
 
 cv::Ptr<cv::aruco::DetectorParameters> DetectorOptions::ToOpenCv() const {
@@ -127,23 +127,47 @@ std::vector<MarkerDetection> MarkerDetector::Detect(const cv::Mat& image) const 
   if (image.channels() == 3) cv::cvtColor(image, gray, cv::COLOR_BGR2GRAY);
   if (image.channels() == 4) cv::cvtColor(image, gray, cv::COLOR_BGRA2GRAY);
   if (gray.depth() != CV_8U) throw std::invalid_argument("MarkerDetector: expected 8-bit image");
-  std::vector<std::vector<cv::Point2f>> corners;
+  const double scale = options_.upsample;
+  cv::Mat work = gray;
+  if (scale > 1.0) cv::resize(gray, work, cv::Size(), scale, scale, cv::INTER_LINEAR);
+  std::vector<std::vector<cv::Point2f>> corners, rejected;
   std::vector<int> ids;
-  cv::aruco::detectMarkers(gray, dictionary_, corners, ids, parameters_);
+  cv::aruco::detectMarkers(work, dictionary_, corners, ids, parameters_, rejected);
   // OpenCV 4.6's AprilTag path returns corners with pixel centres at (0.5, 0.5) (the apriltag
   // library's convention; measured +0.45 px on rendered markers): shift them back.
   const double shift = options_.corner_refinement == CornerRefinement::kAprilTag ? 0.5 : 0.0;
+  // cv::resize maps pixel centres as x_work + 0.5 = scale * (x + 0.5).
+  const auto to_input = [scale, shift](double x_work) {
+    return (x_work - shift + 0.5) / scale - 0.5;
+  };
   std::vector<MarkerDetection> detections;
   detections.reserve(ids.size());
   for (size_t i = 0; i < ids.size(); ++i) {
     if (corners[i].size() != 4) continue;
-    if (options_.corner_refinement == CornerRefinement::kSubpix) RefineSubpix(gray, corners[i]);
+    if (options_.corner_refinement == CornerRefinement::kSubpix) RefineSubpix(work, corners[i]);
     MarkerDetection detection;
     detection.id = ids[i];
     for (int k = 0; k < 4; ++k) {
-      detection.corners[k] = {corners[i][k].x - shift, corners[i][k].y - shift};
+      detection.corners[k] = {to_input(corners[i][k].x), to_input(corners[i][k].y)};
     }
     detections.push_back(detection);
+  }
+  if (options_.rescue_rejected) {
+    CandidateDecoderOptions rescue = options_.rescue;
+    rescue.marker_border_bits = options_.marker_border_bits;
+    for (const std::vector<cv::Point2f>& candidate : rejected) {
+      if (candidate.size() != 4) continue;
+      const std::optional<DecodedCandidate> decoded = DecodeCandidate(
+          work, {candidate[0], candidate[1], candidate[2], candidate[3]}, *dictionary_, rescue);
+      if (!decoded) continue;
+      MarkerDetection detection;  // corners refined by the decoder: OpenCV's convention
+      detection.id = decoded->id;
+      for (int k = 0; k < 4; ++k) {
+        detection.corners[k] = {(decoded->corners[k].x + 0.5) / scale - 0.5,
+                                (decoded->corners[k].y + 0.5) / scale - 0.5};
+      }
+      detections.push_back(detection);
+    }
   }
   return RemoveDuplicateDetections(std::move(detections), options_.dedup_distance_rate);
 }

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "arucoslam/markers/candidate_decoder.h"
+
 namespace arucoslam {
 
 // One detected marker: corners in OpenCV order (top-left, top-right, bottom-right,
@@ -64,6 +66,19 @@ struct DetectorOptions {
   // Two detections of the same id whose centres are closer than this fraction of the
   // smaller one's side are one marker; the one with the larger perimeter is kept.
   double dedup_distance_rate = 0.5;
+  // Scale factor applied to the grey image (cv::resize, INTER_LINEAR) before detection;
+  // corners are mapped back to the input image. 1: none. Markers under about 25 px wide
+  // (3 px per cell or less) are found far more often at 2 or 3, but the cost grows: per
+  // 640x480 frame, measured 6-7 ms at 1, 12-13 ms at 2, 22-23 ms at 3 (CPU time of the
+  // calling thread, bench/marker_bench.cc BM_DetectSmallMarkerOptions), so SLAM frames keep 1.
+  double upsample = 1.0;  // >= 1, <= 8
+  // Candidates that OpenCV rejects (bits unreadable on its decoding grid, as on
+  // small, tilted or blurred markers) are decoded again with sub-pixel corners and bilinear
+  // cell sampling (candidate_decoder.h), with the stricter tolerances of `rescue`. Costs
+  // 0-15% more per 640x480 frame (same benchmark: 6.2 against 6.2 ms, 7.9 against 6.8 ms),
+  // growing with the number of rejected candidates (textured scenes have more).
+  bool rescue_rejected = false;
+  CandidateDecoderOptions rescue;  // its marker_border_bits is taken from above
 
   bool Check() const;
   cv::Ptr<cv::aruco::DetectorParameters> ToOpenCv() const;

@@ -90,13 +90,19 @@ Scene RandomScene(int index, std::mt19937& rng) {
 
 // Issue 2 acceptance: recall >= 99% for a 0.2 m marker up to 4 m, 640x480, fx 500, tilted
 // up to 40 degrees; 50 degrees is measured apart (at 4 m the marker is then 25 x 16 px,
-// under 3 px per cell across): measured 93.8% (90/96) there, asserted >= 90%.
+// under 3 px per cell across). Measured with the default options: 287/288 up to 40 degrees,
+// 90/96 at 50; with rescue_rejected: 288/288 and 91/96. The 50-degree misses are blurred
+// (sigma about 1.1 px) so far that border cells between white neighbours read white even on
+// the true corners (upsampling, finer decoding grids or soft decisions do not recover them
+// without false ids).
 TEST(MarkerDetectorTest, RecallOnWarpedMarkersUpTo4Metres) {
-  const MarkerDetector detector;
+  DetectorOptions rescue_options;
+  rescue_options.rescue_rejected = true;
+  const MarkerDetector detectors[2] = {MarkerDetector(), MarkerDetector(rescue_options)};
   std::mt19937 rng(42);
-  int trials = 0, false_ids = 0;
-  std::map<double, std::pair<int, int>> found_by_tilt;  // tilt -> (found, trials)
-  std::vector<double> corner_errors;
+  int trials = 0, false_ids[2] = {0, 0};
+  std::map<double, std::pair<int, int>> found_by_tilt[2];  // tilt -> (found, trials)
+  std::vector<double> corner_errors[2];
   for (const double depth : {0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0}) {
     for (const double tilt_deg : {0.0, 20.0, 40.0, 50.0}) {
       for (int repeat = 0; repeat < 12; ++repeat) {
@@ -105,44 +111,104 @@ TEST(MarkerDetectorTest, RecallOnWarpedMarkersUpTo4Metres) {
         marker.white_level = scene.white_level;
         const cv::Mat image = RenderSyntheticView(Camera640(), {marker}, scene.view);
         ++trials;
-        bool hit = false;
         const auto truth = ProjectMarkerCorners(Camera640(), marker);
-        for (const MarkerDetection& d : detector.Detect(image)) {
-          if (d.id != marker.id) {
-            ++false_ids;
-            continue;
+        for (int variant = 0; variant < 2; ++variant) {
+          bool hit = false;
+          for (const MarkerDetection& d : detectors[variant].Detect(image)) {
+            if (d.id != marker.id) {
+              ++false_ids[variant];
+              continue;
+            }
+            hit = true;
+            for (int k = 0; k < 4; ++k) {
+              corner_errors[variant].push_back((d.corners[k] - truth[k]).norm());
+            }
           }
-          hit = true;
-          for (int k = 0; k < 4; ++k) corner_errors.push_back((d.corners[k] - truth[k]).norm());
+          found_by_tilt[variant][tilt_deg].first += hit;
+          ++found_by_tilt[variant][tilt_deg].second;
+          if (!hit) {
+            std::printf("variant %d missed: depth %.1f tilt %.0f\n", variant, depth, tilt_deg);
+          }
         }
-        found_by_tilt[tilt_deg].first += hit;
-        ++found_by_tilt[tilt_deg].second;
-        if (!hit) std::printf("missed: depth %.1f tilt %.0f\n", depth, tilt_deg);
       }
     }
   }
-  int found = 0, counted = 0;
-  for (const auto& [tilt, counts] : found_by_tilt) {
-    std::printf("tilt %2.0f deg: recall %.4f (%d/%d)\n", tilt, counts.first / double(counts.second),
-                counts.first, counts.second);
-    if (tilt <= 40.0) {
-      found += counts.first;
-      counted += counts.second;
+  for (int variant = 0; variant < 2; ++variant) {
+    int found = 0, counted = 0;
+    for (const auto& [tilt, counts] : found_by_tilt[variant]) {
+      std::printf("%s tilt %2.0f deg: recall %.4f (%d/%d)\n", variant ? "rescue" : "default", tilt,
+                  counts.first / double(counts.second), counts.first, counts.second);
+      if (tilt <= 40.0) {
+        found += counts.first;
+        counted += counts.second;
+      }
+    }
+    std::vector<double>& errors = corner_errors[variant];
+    std::sort(errors.begin(), errors.end());
+    const double median = errors[errors.size() / 2];
+    const double p95 = errors[errors.size() * 95 / 100];
+    std::printf(
+        "%s: recall up to 40 deg %.4f (%d/%d), false ids %d, corner error median %.3f px "
+        "p95 %.3f px max %.3f px\n",
+        variant ? "rescue" : "default", found / double(counted), found, counted, false_ids[variant],
+        median, p95, errors.back());
+    EXPECT_GE(found / double(counted), 0.99) << variant;
+    EXPECT_EQ(false_ids[variant], 0) << variant;
+    EXPECT_LT(median, 0.3) << variant;
+    // No gross corner error (an inner cell corner or the margin would be >= 2 px off).
+    EXPECT_LT(errors.back(), 1.5) << variant;
+  }
+  const auto recall_50 = [&](int variant) {
+    return found_by_tilt[variant][50.0].first / double(found_by_tilt[variant][50.0].second);
+  };
+  EXPECT_GE(recall_50(0), 0.90);
+  EXPECT_GE(recall_50(1), 0.94);
+  EXPECT_EQ(found_by_tilt[1][40.0].first, 96);
+}
+
+// The upsampled detection maps corners back with pixel centres at integer coordinates:
+// no bias against the true corners, at every factor and refinement.
+TEST(MarkerDetectorTest, UpsampledCornersKeepPixelCentres) {
+  for (const CornerRefinement refinement :
+       {CornerRefinement::kSubpix, CornerRefinement::kAprilTag}) {
+    for (const double upsample : {1.0, 2.0, 3.0}) {
+      DetectorOptions options;
+      options.corner_refinement = refinement;
+      options.upsample = upsample;
+      const MarkerDetector detector(options);
+      Eigen::Vector2d offset = Eigen::Vector2d::Zero();
+      double worst = 0.0;
+      int count = 0;
+      for (int i = 0; i < 8; ++i) {
+        SyntheticMarker marker;
+        marker.id = 5 + i;
+        marker.cam_from_marker =
+            Rigid3(Eigen::Matrix3d(Eigen::AngleAxisd(0.35, Eigen::Vector3d(0.8, 0.6, 0)) *
+                                   Eigen::Vector3d(1, -1, -1).asDiagonal() *
+                                   Eigen::AngleAxisd(0.4 * i, Eigen::Vector3d::UnitZ())),
+                   Eigen::Vector3d(0.03 * i - 0.1, -0.05, 1.0 + 0.3 * i));
+        SyntheticViewOptions view;
+        view.seed = 50 + i;
+        view.noise_sigma = 1.0;
+        const cv::Mat image = RenderSyntheticView(Camera640(), {marker}, view);
+        const auto truth = ProjectMarkerCorners(Camera640(), marker);
+        for (const MarkerDetection& d : detector.Detect(image)) {
+          ASSERT_EQ(d.id, marker.id);
+          for (int k = 0; k < 4; ++k) {
+            offset += d.corners[k] - truth[k];
+            worst = std::max(worst, (d.corners[k] - truth[k]).norm());
+            ++count;
+          }
+        }
+      }
+      ASSERT_EQ(count, 32) << "upsample " << upsample;
+      offset /= count;
+      std::printf("refinement %d upsample %.0f: mean offset (%.3f, %.3f) px, worst %.3f px\n",
+                  static_cast<int>(refinement), upsample, offset.x(), offset.y(), worst);
+      EXPECT_LT(offset.norm(), 0.15) << "upsample " << upsample;
+      EXPECT_LT(worst, 1.0) << "upsample " << upsample;
     }
   }
-  std::sort(corner_errors.begin(), corner_errors.end());
-  const double median = corner_errors[corner_errors.size() / 2];
-  const double p95 = corner_errors[corner_errors.size() * 95 / 100];
-  std::printf(
-      "recall up to 40 deg %.4f (%d/%d), false ids %d, corner error median %.3f px "
-      "p95 %.3f px max %.3f px\n",
-      found / double(counted), found, counted, false_ids, median, p95, corner_errors.back());
-  EXPECT_GE(found / double(counted), 0.99);
-  EXPECT_GE(found_by_tilt[50.0].first / double(found_by_tilt[50.0].second), 0.90);
-  EXPECT_EQ(false_ids, 0);
-  EXPECT_LT(median, 0.3);
-  // No gross corner error (an inner cell corner or the margin would be >= 2 px off).
-  EXPECT_LT(corner_errors.back(), 1.5);
 }
 
 // DESIGN.md pitfall: a 1-cell margin on a darker background must be detected, once
@@ -236,6 +302,12 @@ TEST(MarkerDetectorTest, OptionsAreChecked) {
   EXPECT_TRUE(options.Check());
   options.adaptive_thresh_win_size_max = 2;
   EXPECT_FALSE(options.Check());
+  DetectorOptions small_upsample;
+  small_upsample.upsample = 0.5;
+  EXPECT_FALSE(small_upsample.Check());
+  DetectorOptions bad_rescue;
+  bad_rescue.rescue.ignored_margin_per_cell = 0.5;
+  EXPECT_FALSE(bad_rescue.Check());
   EXPECT_THROW(MarkerDetector{options}, std::invalid_argument);
   DetectorOptions unknown;
   unknown.dictionary = "DICT_9X9_7";
@@ -322,21 +394,30 @@ bool CornersMatchAsSets(const ExpectedTag& tag, const MarkerDetection& detection
 
 // Real photos (github.com/AprilRobotics/apriltag test data), compared as sets within 1 px
 // (the libraries order corners differently). The expectations use the apriltag library's
-// pixel convention (centres at 0.5), so they are shifted by -0.5 px to OpenCV's. OpenCV
-// 4.6's aruco finds only part of these 15-20 px tags (2-2.5 px per cell, JPEG): measured
-// 22 of 47 with the settings below (AprilTag quads, 8 px per cell, 0.25 cell margin),
-// 15 with the AprilTag defaults and none within 1 px with sub-pixel refinement. The test
-// holds that figure and that every detection is a correct one.
+// pixel convention (centres at 0.5), so they are shifted by -0.5 px to OpenCV's. The tags
+// are 10-45 px wide (2-2.5 px per cell for most, JPEG). OpenCV 4.6 at full resolution finds
+// 22 of 47 (AprilTag quads, 8 px per cell, 0.25 cell margin); upsampled 2x with 4 px per
+// cell and rescue_rejected, 41 within 1 px. Of the other six, two are found with a corner
+// 1.05 and 2.65 px off (an acute corner of a tag seen edge-on) and four are missed (10 and
+// 13 px wide, or in deep shadow). Three more real tags that the expectations lack (checked
+// by eye) are found; any other detection fails the test.
 TEST(MarkerDetectorRealTest, AprilTagDetectUnitCorners) {
   const std::filesystem::path dir = DataDir("apriltag_detect_unit");
   if (!std::filesystem::exists(dir)) GTEST_SKIP() << "test data folder missing: " << dir;
   DetectorOptions options;
   options.dictionary = "DICT_APRILTAG_36h11";
   options.corner_refinement = CornerRefinement::kAprilTag;
-  options.perspective_remove_pixel_per_cell = 8;
+  options.perspective_remove_pixel_per_cell = 4;
   options.perspective_remove_ignored_margin_per_cell = 0.25;
+  options.upsample = 2.0;
+  options.rescue_rejected = true;
   const MarkerDetector detector(options);
-  int expected_total = 0, matched_total = 0, wrong_total = 0;
+  // Tags in the photos that the expectations lack: image, centre (pixels).
+  const std::vector<std::pair<std::string, Eigen::Vector2d>> unlisted = {
+      {"34085369442_304b6bafd9_c.jpg", {37, 347}},
+      {"34085369442_304b6bafd9_c.jpg", {476, 333}},
+      {"34139872896_defdb2f8d9_c.jpg", {772, 348}}};
+  int expected_total = 0, matched_total = 0, near_total = 0, unlisted_total = 0, wrong_total = 0;
   double worst_total = 0.0;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     if (entry.path().extension() != ".txt") continue;
@@ -350,30 +431,43 @@ TEST(MarkerDetectorRealTest, AprilTagDetectUnitCorners) {
     ASSERT_FALSE(image.empty()) << image_path;
     const std::vector<MarkerDetection> detections = detector.Detect(image);
     std::vector<bool> used(detections.size(), false);
-    int matched = 0;
+    int matched = 0, near = 0;
     for (const ExpectedTag& tag : tags) {
       for (size_t i = 0; i < detections.size(); ++i) {
         double worst = 0.0;
         if (used[i] || detections[i].id != tag.id) continue;
-        if (CornersMatchAsSets(tag, detections[i], 1.0, &worst)) {
+        const bool within_1px = CornersMatchAsSets(tag, detections[i], 1.0, &worst);
+        if (within_1px || worst < 3.0) {
           used[i] = true;
-          ++matched;
-          worst_total = std::max(worst_total, worst);
+          (within_1px ? matched : near) += 1;
+          if (within_1px) worst_total = std::max(worst_total, worst);
           break;
         }
       }
     }
-    const int wrong = static_cast<int>(std::count(used.begin(), used.end(), false));
-    std::printf("%s: %zu expected, %d found, %d detections not expected\n",
-                image_path.filename().c_str(), tags.size(), matched, wrong);
+    int unlisted_found = 0, wrong = 0;
+    for (size_t i = 0; i < detections.size(); ++i) {
+      if (used[i]) continue;
+      const bool known = std::any_of(unlisted.begin(), unlisted.end(), [&](const auto& tag) {
+        return tag.first == image_path.filename().string() &&
+               (tag.second - detections[i].Center()).norm() < 5.0;
+      });
+      (known ? unlisted_found : wrong) += 1;
+    }
+    std::printf("%s: %zu expected, %d found within 1 px, %d within 3 px, %d unlisted, %d wrong\n",
+                image_path.filename().c_str(), tags.size(), matched, near, unlisted_found, wrong);
     expected_total += static_cast<int>(tags.size());
     matched_total += matched;
+    near_total += near;
+    unlisted_total += unlisted_found;
     wrong_total += wrong;
   }
-  std::printf("apriltag: %d of %d found, worst corner %.3f px\n", matched_total, expected_total,
-              worst_total);
+  std::printf("apriltag: %d of %d found within 1 px (worst %.3f px), %d more within 3 px\n",
+              matched_total, expected_total, worst_total, near_total);
   EXPECT_EQ(expected_total, 47);
-  EXPECT_GE(matched_total, 22);
+  EXPECT_GE(matched_total, 41);
+  EXPECT_LE(near_total, 47 - matched_total);
+  EXPECT_EQ(unlisted_total, 3);
   EXPECT_EQ(wrong_total, 0);
 }
 

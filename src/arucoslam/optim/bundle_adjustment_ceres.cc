@@ -7,60 +7,17 @@
 #include <vector>
 
 #include "arucoslam/optim/bundle_adjustment.h"
+#include "arucoslam/optim/se3_manifold_ceres.h"
 #include "arucoslam/util/timing.h"
 
 namespace arucoslam {
 namespace {
 
-constexpr int kPoseSize = 7;
-constexpr int kPoseTangentSize = 6;
-
-Rigid3 PoseFromBlock(const double* block) {
-  return Rigid3(Eigen::Quaterniond(block[3], block[0], block[1], block[2]),
-                Eigen::Vector3d(block[4], block[5], block[6]));
-}
-
-void PoseToBlock(const Rigid3& pose, double* block) {
-  const Eigen::Quaterniond q = pose.rotation.normalized();
-  block[0] = q.x();
-  block[1] = q.y();
-  block[2] = q.z();
-  block[3] = q.w();
-  block[4] = pose.translation.x();
-  block[5] = pose.translation.y();
-  block[6] = pose.translation.z();
-}
-
-// Left-multiplicative SE(3) update, x + delta = Exp(delta) * x. The cost functions report
-// their Jacobians directly w.r.t. delta in the first six ambient columns (the seventh is
-// zero), so PlusJacobian is [I6; 0] and Ceres' product gives the tangent Jacobian exactly.
-class Se3LeftManifold : public ceres::Manifold {
- public:
-  int AmbientSize() const override { return kPoseSize; }
-  int TangentSize() const override { return kPoseTangentSize; }
-  bool Plus(const double* x, const double* delta, double* x_plus_delta) const override {
-    const Vector6d tangent = Eigen::Map<const Vector6d>(delta);
-    PoseToBlock(Rigid3::Exp(tangent) * PoseFromBlock(x), x_plus_delta);
-    return true;
-  }
-  bool PlusJacobian(const double* x, double* jacobian) const override {
-    Eigen::Map<Eigen::Matrix<double, kPoseSize, kPoseTangentSize, Eigen::RowMajor>> j(jacobian);
-    j.setZero();
-    j.topRows<kPoseTangentSize>().setIdentity();
-    return true;
-  }
-  bool Minus(const double* y, const double* x, double* y_minus_x) const override {
-    Eigen::Map<Vector6d> tangent(y_minus_x);
-    tangent = (PoseFromBlock(y) * PoseFromBlock(x).Inverse()).Log();
-    return true;
-  }
-  bool MinusJacobian(const double* x, double* jacobian) const override {
-    Eigen::Map<Eigen::Matrix<double, kPoseTangentSize, kPoseSize, Eigen::RowMajor>> j(jacobian);
-    j.setZero();
-    j.leftCols<kPoseTangentSize>().setIdentity();
-    return true;
-  }
-};
+using ceres_internal::kPoseSize;
+using ceres_internal::kPoseTangentSize;
+using ceres_internal::PoseFromBlock;
+using ceres_internal::PoseToBlock;
+using ceres_internal::Se3LeftManifold;
 
 // Whitened reprojection residual r / sigma over a pose block and a point block.
 class ReprojectionCost : public ceres::SizedCostFunction<2, kPoseSize, 3> {

@@ -35,8 +35,8 @@ double MarkerReprojectionRmsPixels(const MarkerBundleAdjustmentProblem& problem)
   for (const auto& observation : problem.marker_observations) {
     const auto& marker = problem.markers[observation.marker_index];
     Vector8d residual;
-    const MarkerCornerError error(problem.keypoints.intrinsics,
-                                  SquareCorners(marker.size), observation.corners_px);
+    const MarkerCornerError error(problem.keypoints.intrinsics, SquareCorners(marker.size),
+                                  observation.corners_px);
     if (error.Evaluate(problem.keypoints.poses[observation.pose_index].cam_from_world,
                        marker.world_from_marker, &residual)) {
       sum += residual.squaredNorm();

@@ -38,10 +38,10 @@ struct MarkerBundleAdjustmentProblem {
     bool fixed = false;  // known marker (markers.json): held constant
   };
   struct CornerObservation {
-    std::size_t pose_index = 0;    // into keypoints.poses
-    std::size_t marker_index = 0;  // into markers
+    std::size_t pose_index = 0;                   // into keypoints.poses
+    std::size_t marker_index = 0;                 // into markers
     std::array<Eigen::Vector2d, 4> corners_px{};  // undistorted pixels, OpenCV order
-    double sigma_px = 1.0;                         // corner noise, pixels
+    double sigma_px = 1.0;                        // corner noise, pixels
   };
 
   // Poses, points, keypoint observations and the single camera's intrinsics.

@@ -8,55 +8,19 @@
 
 #include "arucoslam/markers/marker_pose.h"
 #include "arucoslam/optim/marker_bundle_adjustment.h"
+#include "arucoslam/optim/se3_manifold_ceres.h"
 #include "arucoslam/util/timing.h"
 
 namespace arucoslam {
 namespace {
 
-constexpr int kPoseSize = 7;
-constexpr int kTangentSize = 6;
-using PoseBlock = std::array<double, kPoseSize>;
+using ceres_internal::kPoseSize;
+using ceres_internal::PoseBlock;
+constexpr int kTangentSize = ceres_internal::kPoseTangentSize;
+using LeftSe3Manifold = ceres_internal::Se3LeftManifold;
 
-Rigid3 FromBlock(const double* block) {
-  return Rigid3(Eigen::Quaterniond(block[3], block[0], block[1], block[2]),
-                Eigen::Vector3d(block[4], block[5], block[6]));
-}
-
-PoseBlock ToBlock(const Rigid3& pose) {
-  const Eigen::Quaterniond q = pose.rotation.normalized();
-  return {q.x(), q.y(), q.z(), q.w(), pose.translation.x(), pose.translation.y(),
-          pose.translation.z()};
-}
-
-// x + delta = Exp(delta) * x. Costs report Jacobians w.r.t. delta in the first six ambient
-// columns (the seventh is zero), so PlusJacobian is [I6; 0].
-class LeftSe3Manifold : public ceres::Manifold {
- public:
-  int AmbientSize() const override { return kPoseSize; }
-  int TangentSize() const override { return kTangentSize; }
-  bool Plus(const double* x, const double* delta, double* x_plus_delta) const override {
-    const PoseBlock result = ToBlock(Rigid3::Exp(Eigen::Map<const Vector6d>(delta)) * FromBlock(x));
-    std::copy(result.begin(), result.end(), x_plus_delta);
-    return true;
-  }
-  bool PlusJacobian(const double* x, double* jacobian) const override {
-    Eigen::Map<Eigen::Matrix<double, kPoseSize, kTangentSize, Eigen::RowMajor>> j(jacobian);
-    j.setZero();
-    j.topRows<kTangentSize>().setIdentity();
-    return true;
-  }
-  bool Minus(const double* y, const double* x, double* y_minus_x) const override {
-    Eigen::Map<Vector6d> tangent(y_minus_x);
-    tangent = (FromBlock(y) * FromBlock(x).Inverse()).Log();
-    return true;
-  }
-  bool MinusJacobian(const double* x, double* jacobian) const override {
-    Eigen::Map<Eigen::Matrix<double, kTangentSize, kPoseSize, Eigen::RowMajor>> j(jacobian);
-    j.setZero();
-    j.leftCols<kTangentSize>().setIdentity();
-    return true;
-  }
-};
+Rigid3 FromBlock(const double* block) { return ceres_internal::PoseFromBlock(block); }
+PoseBlock ToBlock(const Rigid3& pose) { return ceres_internal::PoseToBlock(pose); }
 
 // Writes a whitened residual Jacobian (rows x 6) into a rows x 7 row-major Ceres block.
 template <int Rows>
@@ -205,10 +169,10 @@ void FlagOutliers(const MarkerBundleAdjustmentOptions& options,
   for (std::size_t i = 0; i < keypoints.observations.size(); ++i) {
     const auto& observation = keypoints.observations[i];
     Eigen::Vector2d residual;
-    const bool in_front = ReprojectionError(keypoints.intrinsics, observation.pixel)
-                              .Evaluate(keypoints.poses[observation.pose_index].cam_from_world,
-                                        keypoints.points[observation.point_index].p_in_world,
-                                        &residual);
+    const bool in_front =
+        ReprojectionError(keypoints.intrinsics, observation.pixel)
+            .Evaluate(keypoints.poses[observation.pose_index].cam_from_world,
+                      keypoints.points[observation.point_index].p_in_world, &residual);
     const double chi2 = residual.squaredNorm() / (observation.sigma_px * observation.sigma_px);
     summary->keypoint_outliers[i] = !in_front || chi2 > options.solver.chi_square_threshold;
     summary->num_keypoint_outliers += summary->keypoint_outliers[i] ? 1 : 0;

@@ -12,8 +12,8 @@ namespace {
 Rigid3 CameraPose(const Eigen::Vector3d& position, double yaw) {
   Eigen::Matrix3d world_from_cam_rotation;
   world_from_cam_rotation.col(0) = Eigen::Vector3d(std::sin(yaw), -std::cos(yaw), 0.0);  // right
-  world_from_cam_rotation.col(1) = Eigen::Vector3d(0.0, 0.0, -1.0);                     // down
-  world_from_cam_rotation.col(2) = Eigen::Vector3d(std::cos(yaw), std::sin(yaw), 0.0);  // ahead
+  world_from_cam_rotation.col(1) = Eigen::Vector3d(0.0, 0.0, -1.0);                      // down
+  world_from_cam_rotation.col(2) = Eigen::Vector3d(std::cos(yaw), std::sin(yaw), 0.0);   // ahead
   return Rigid3(world_from_cam_rotation, position).Inverse();
 }
 
@@ -21,7 +21,7 @@ Rigid3 CameraPose(const Eigen::Vector3d& position, double yaw) {
 Rigid3 FacingMarkerPose(const Eigen::Vector3d& position, double yaw) {
   Eigen::Matrix3d rotation;
   rotation.col(0) = Eigen::Vector3d(std::sin(yaw), -std::cos(yaw), 0.0);   // right, as seen
-  rotation.col(1) = Eigen::Vector3d(0.0, 0.0, 1.0);                       // up
+  rotation.col(1) = Eigen::Vector3d(0.0, 0.0, 1.0);                        // up
   rotation.col(2) = Eigen::Vector3d(-std::cos(yaw), -std::sin(yaw), 0.0);  // out of the face
   return Rigid3(rotation, position);
 }
@@ -34,8 +34,7 @@ bool SyntheticMarkerSceneOptions::Check() const {
          corner_noise_px >= 0.0 && image_width > 0 && image_height > 0 && focal_px > 0.0;
 }
 
-MarkerBundleAdjustmentProblem MakeSyntheticMarkerScene(
-    const SyntheticMarkerSceneOptions& options) {
+MarkerBundleAdjustmentProblem MakeSyntheticMarkerScene(const SyntheticMarkerSceneOptions& options) {
   MarkerBundleAdjustmentProblem scene;
   auto& keypoints = scene.keypoints;
   keypoints.intrinsics = {options.focal_px, options.focal_px, 0.5 * (options.image_width - 1),
@@ -46,7 +45,8 @@ MarkerBundleAdjustmentProblem MakeSyntheticMarkerScene(
   const double length = options.path_length_m;
   for (int i = 0; i < options.num_poses; ++i) {
     const double t = static_cast<double>(i) / (options.num_poses - 1);
-    const Eigen::Vector3d position(t * length, 0.3 * std::sin(3.0 * t), 1.0 + 0.05 * std::sin(7 * t));
+    const Eigen::Vector3d position(t * length, 0.3 * std::sin(3.0 * t),
+                                   1.0 + 0.05 * std::sin(7 * t));
     keypoints.poses.push_back({CameraPose(position, 0.12 * std::sin(5.0 * t)), false});
   }
   for (int i = 0; i < options.num_points; ++i) {
@@ -57,8 +57,8 @@ MarkerBundleAdjustmentProblem MakeSyntheticMarkerScene(
   for (int i = 0; i < options.num_markers; ++i) {
     const double x = 3.0 + (length + 4.0) * i / std::max(1, options.num_markers - 1);
     const Eigen::Vector3d position(x, (i % 2 == 0 ? 1.0 : -1.0) * 0.8, 1.0 + 0.2 * (i % 3));
-    scene.markers.push_back({FacingMarkerPose(position, 0.3 * (i % 2 == 0 ? -1 : 1)),
-                             options.marker_size_m, true});
+    scene.markers.push_back(
+        {FacingMarkerPose(position, 0.3 * (i % 2 == 0 ? -1 : 1)), options.marker_size_m, true});
   }
   const auto in_image = [&](const Eigen::Vector2d& pixel) {
     return pixel.x() >= 0 && pixel.y() >= 0 && pixel.x() <= options.image_width - 1 &&

@@ -15,9 +15,9 @@ struct SyntheticMarkerSceneOptions {
   int num_markers = 4;         // markers spread from 3 m ahead of the start to past the end
   double marker_size_m = 0.3;  // side of each marker's black square
   double max_marker_distance_m = 10.0;  // markers farther from a camera are not observed
-  double noise_px = 0.0;         // Gaussian noise (std dev) on keypoint pixels
-  double corner_noise_px = 0.0;  // Gaussian noise (std dev) on marker corner pixels
-  int image_width = 640;         // observations outside the image are dropped
+  double noise_px = 0.0;                // Gaussian noise (std dev) on keypoint pixels
+  double corner_noise_px = 0.0;         // Gaussian noise (std dev) on marker corner pixels
+  int image_width = 640;                // observations outside the image are dropped
   int image_height = 480;
   double focal_px = 500.0;  // fx = fy; principal point at the image centre
   std::uint32_t seed = 1;

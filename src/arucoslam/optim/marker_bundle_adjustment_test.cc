@@ -34,7 +34,8 @@ void Distort(const Sim3& moved_from_true, double drift, MarkerBundleAdjustmentPr
     for (int k = 0; k < 6; ++k) delta[k] = drift * normal(random);
     pose.cam_from_world = Rigid3::Exp(delta) * world_from_cam.Inverse();
   }
-  for (auto& point : problem->keypoints.points) point.p_in_world = moved_from_true * point.p_in_world;
+  for (auto& point : problem->keypoints.points)
+    point.p_in_world = moved_from_true * point.p_in_world;
 }
 
 double MaxCentreError(const MarkerBundleAdjustmentProblem& a,
@@ -59,7 +60,8 @@ TEST(MarkerBundleAdjustmentTest, SceneSeesEveryMarkerFromSeveralPoses) {
 TEST(MarkerBundleAdjustmentTest, FixedMarkersPullAScaledDriftedMapIntoTheWorld) {
   const MarkerBundleAdjustmentProblem truth = MakeSyntheticMarkerScene(NoisyScene());
   MarkerBundleAdjustmentProblem problem = truth;
-  const Sim3 moved_from_true(1.08, Eigen::Quaterniond(Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitZ())),
+  const Sim3 moved_from_true(1.08,
+                             Eigen::Quaterniond(Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitZ())),
                              Eigen::Vector3d(0.2, -0.1, 0.05));
   Distort(moved_from_true, 0.005, &problem);
   ASSERT_GT(MaxCentreError(problem, truth), 0.3);
@@ -117,7 +119,8 @@ TEST(MarkerBundleAdjustmentTest, UnknownMarkersAreEstimatedAgainstOneKnownMarker
     Vector6d delta;
     for (int k = 0; k < 3; ++k) delta[k] = 0.1 * normal(random);
     for (int k = 3; k < 6; ++k) delta[k] = 0.08 * normal(random);
-    problem.markers[m].world_from_marker = Rigid3::Exp(delta) * problem.markers[m].world_from_marker;
+    problem.markers[m].world_from_marker =
+        Rigid3::Exp(delta) * problem.markers[m].world_from_marker;
   }
   const auto summary = SolveMarkerBundleAdjustment(options, &problem);
   ASSERT_TRUE(summary.success) << summary.message;

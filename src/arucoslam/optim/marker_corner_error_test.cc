@@ -71,10 +71,12 @@ TEST(MarkerCornerErrorTest, JacobiansMatchNumericDifferences) {
     delta[k] = h;
     Vector8d plus, minus;
     ASSERT_TRUE(error.Evaluate(Rigid3::Exp(delta) * s.cam_from_world, s.world_from_marker, &plus));
-    ASSERT_TRUE(error.Evaluate(Rigid3::Exp(-delta) * s.cam_from_world, s.world_from_marker, &minus));
+    ASSERT_TRUE(
+        error.Evaluate(Rigid3::Exp(-delta) * s.cam_from_world, s.world_from_marker, &minus));
     numeric_cam.col(k) = (plus - minus) / (2 * h);
     ASSERT_TRUE(error.Evaluate(s.cam_from_world, Rigid3::Exp(delta) * s.world_from_marker, &plus));
-    ASSERT_TRUE(error.Evaluate(s.cam_from_world, Rigid3::Exp(-delta) * s.world_from_marker, &minus));
+    ASSERT_TRUE(
+        error.Evaluate(s.cam_from_world, Rigid3::Exp(-delta) * s.world_from_marker, &minus));
     numeric_marker.col(k) = (plus - minus) / (2 * h);
   }
   // Entries are hundreds of pixels per unit; central differences agree to ~1e-6 relative.

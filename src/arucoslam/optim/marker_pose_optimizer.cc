@@ -38,9 +38,11 @@ struct FrameProblem {
   std::vector<bool> marker_active;  // markers
 
   // Whitened squared error of keypoint i, or -1 when behind the camera (with Jacobian).
-  double Keypoint(std::size_t i, const Rigid3& pose, Eigen::Vector2d* r, PoseJacobian* j) const {
+  // `rotation` is pose's rotation matrix (computed once per pass over the observations).
+  double Keypoint(std::size_t i, const Rigid3& pose, const Eigen::Matrix3d& rotation,
+                  Eigen::Vector2d* r, PoseJacobian* j) const {
     if (!ReprojectionError(intrinsics, observations[i].pixel)
-             .Evaluate(pose, observations[i].p_in_world, r, j)) {
+             .Evaluate(rotation, pose.translation, observations[i].p_in_world, r, j, nullptr)) {
       return -1.0;
     }
     return r->squaredNorm() / (observations[i].sigma_px * observations[i].sigma_px);
@@ -53,11 +55,12 @@ struct FrameProblem {
   Normal Accumulate(const Rigid3& pose, bool robust, bool jacobians) const {
     Normal normal;
     const double behind_cost = 2e3 * options.keypoints.huber_delta;
+    const Eigen::Matrix3d rotation = pose.RotationMatrix();
     for (std::size_t i = 0; i < observations.size(); ++i) {
       if (!active[i]) continue;
       Eigen::Vector2d r;
       PoseJacobian j;
-      const double chi2 = Keypoint(i, pose, &r, jacobians ? &j : nullptr);
+      const double chi2 = Keypoint(i, pose, rotation, &r, jacobians ? &j : nullptr);
       if (chi2 < 0.0) {
         normal.cost += behind_cost;
         continue;
@@ -138,9 +141,10 @@ MarkerPoseOptimizationResult OptimizePoseWithMarkers(
     result.cam_from_world = problem.Round(result.cam_from_world, robust);
     result.num_inliers = 0;
     result.num_marker_inliers = 0;
+    const Eigen::Matrix3d rotation = result.cam_from_world.RotationMatrix();
     for (std::size_t i = 0; i < observations.size(); ++i) {
       Eigen::Vector2d r;
-      const double chi2 = problem.Keypoint(i, result.cam_from_world, &r, nullptr);
+      const double chi2 = problem.Keypoint(i, result.cam_from_world, rotation, &r, nullptr);
       problem.active[i] = chi2 >= 0.0 && chi2 <= options.keypoints.chi_square_threshold;
       result.num_inliers += problem.active[i] ? 1 : 0;
     }
@@ -159,9 +163,11 @@ MarkerPoseOptimizationResult OptimizePoseWithMarkers(
   result.success =
       result.num_inliers >= options.keypoints.min_inliers || result.num_marker_inliers > 0;
   double sum = 0.0, marker_sum = 0.0;
+  const Eigen::Matrix3d rotation = result.cam_from_world.RotationMatrix();
   for (std::size_t i = 0; i < observations.size(); ++i) {
     Eigen::Vector2d r;
-    if (problem.active[i] && problem.Keypoint(i, result.cam_from_world, &r, nullptr) >= 0.0) {
+    if (problem.active[i] &&
+        problem.Keypoint(i, result.cam_from_world, rotation, &r, nullptr) >= 0.0) {
       sum += r.squaredNorm();
     }
   }

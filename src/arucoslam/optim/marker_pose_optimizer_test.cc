@@ -96,9 +96,9 @@ TEST(MarkerPoseOptimizerTest, FewKeypointsFailWithoutAMarker) {
   const auto scene = MakeSyntheticMarkerScene(Noisy());
   FrameData frame = Frame(scene, 4);
   frame.keypoints.resize(5);  // below min_inliers (10)
-  EXPECT_FALSE(OptimizePoseWithMarkers(frame.keypoints, {}, frame.true_cam_from_world,
-                                       frame.intrinsics)
-                   .success);
+  EXPECT_FALSE(
+      OptimizePoseWithMarkers(frame.keypoints, {}, frame.true_cam_from_world, frame.intrinsics)
+          .success);
   EXPECT_TRUE(OptimizePoseWithMarkers(frame.keypoints, frame.markers, frame.true_cam_from_world,
                                       frame.intrinsics)
                   .success);

@@ -11,7 +11,11 @@ namespace arucoslam {
 bool SystemOptions::Check() const {
   return extractor.Check() && initializer.Check() && initial_map.Check() && tracker.Check() &&
          keyframes.Check() && mapper.Check() && mapper_queue_capacity >= 1 &&
-         max_initialization_gap_s > 0.0 && reset_max_keyframes >= 0;
+         max_initialization_gap_s > 0.0 && reset_max_keyframes >= 0 && detector.Check() &&
+         locator.Check() && alignment.Check() && max_marker_rms_px > 0.0 &&
+         min_alignment_anchors >= 2 && min_alignment_baseline_m >= 0.0 &&
+         max_alignment_rms_m > 0.0 && marker_reset_lost_frames >= 1 &&
+         max_realignment_anchors >= min_alignment_anchors;
 }
 
 System::System(const CameraModel& camera, const SystemOptions& options)
@@ -23,6 +27,7 @@ System::System(const CameraModel& camera, const SystemOptions& options)
   map_ = std::make_unique<Map>();
   tracker_ = std::make_unique<Tracker>(*map_, options_.tracker);
   mapper_ = std::make_unique<LocalMapper>(*map_, options_.mapper);
+  if (options_.marker_map) detector_ = std::make_unique<MarkerDetector>(options_.detector);
   StartMappingThread();
 }
 
@@ -82,14 +87,22 @@ FrameReport System::ProcessImage(const cv::Mat& grey, double timestamp_s) {
   UndistortFeatures(camera_, &frame.features);
   frame.ResetMatches();
   const double extraction = watch.ElapsedMilliseconds();
-  FrameReport report = ProcessFrame(std::move(frame));
+  std::vector<MarkerDetection> detections;
+  if (detector_) {
+    const Stopwatch detection;
+    detections = detector_->Detect(grey);
+    detection_ms_ = detection.ElapsedMilliseconds();
+  }
+  FrameReport report = ProcessFrame(std::move(frame), detections);
   std::lock_guard lock(stats_mutex_);
   stats_.extraction_ms.Add(extraction);
   stats_.frame_ms.Add(watch.ElapsedMilliseconds());
   return report;
 }
 
-FrameReport System::ProcessFrame(Frame frame) {
+FrameReport System::ProcessFrame(Frame frame) { return ProcessFrame(std::move(frame), {}); }
+
+FrameReport System::ProcessFrame(Frame frame, const std::vector<MarkerDetection>& detections) {
   if (finished_) throw std::logic_error("System::ProcessFrame after Finish");
   const Stopwatch watch;
   FrameReport report;
@@ -97,11 +110,14 @@ FrameReport System::ProcessFrame(Frame frame) {
   report.timestamp_s = frame.timestamp_s;
   report.num_features = static_cast<int>(frame.features.size());
   if (frame.map_point_ids.size() != frame.features.size()) frame.ResetMatches();
+  fix_ = LocateWithMarkers(frame, detections, report);
   if (tracker_->state() == TrackingState::kNotInitialized) {
     Initialize(frame, report);
   } else {
     Track(frame, report);
   }
+  if (!report.cam_from_world && fix_) RecordMarkerPose(frame, report);
+  report.world_aligned = world_aligned_;
   {
     std::lock_guard lock(stats_mutex_);
     ++stats_.num_frames;
@@ -121,7 +137,10 @@ void System::Initialize(Frame& frame, FrameReport& report) {
   const bool enough = report.num_features >= options_.initializer.min_matches;
   if (!init_reference_ ||
       frame.timestamp_s - init_reference_->timestamp_s > options_.max_initialization_gap_s) {
-    if (enough) init_reference_ = frame;
+    if (enough) {
+      init_reference_ = frame;
+      init_reference_fix_ = fix_;
+    }
     report.message = enough ? "initialisation reference" : "too few features";
     return;
   }
@@ -136,7 +155,10 @@ void System::Initialize(Frame& frame, FrameReport& report) {
                       result.success ? "succeeded" : InitFailureName(result.failure),
                       result.message);
   if (!result.success) {
-    if (result.failure == InitFailure::kTooFewMatches && enough) init_reference_ = frame;
+    if (result.failure == InitFailure::kTooFewMatches && enough) {
+      init_reference_ = frame;
+      init_reference_fix_ = fix_;
+    }
     return;
   }
   Frame first = *init_reference_;
@@ -149,7 +171,20 @@ void System::Initialize(Frame& frame, FrameReport& report) {
   init_reference_.reset();
   tracker_->Start(frame, created.second);
   RecordPose(first, created.first);
+  // The reference frame may have got a marker-only pose when it was seen: that entry is
+  // replaced in place (the order of poses_ stays the order of time).
+  for (std::size_t i = 0; i + 1 < poses_.size(); ++i) {
+    if (poses_[i].timestamp_s == first.timestamp_s) {
+      poses_[i] = poses_.back();
+      poses_.pop_back();
+      break;
+    }
+  }
   RecordPose(frame, created.second);
+  AddAnchor(created.first, init_reference_fix_);
+  AddAnchor(created.second, fix_);
+  init_reference_fix_.reset();
+  MaybeAlignWorld(&frame);
   frames_since_keyframe_ = 0;
   last_state_ = TrackingState::kTracking;
   report.state = TrackingState::kTracking;
@@ -164,7 +199,12 @@ void System::Initialize(Frame& frame, FrameReport& report) {
 }
 
 void System::Track(Frame& frame, FrameReport& report) {
-  const TrackingResult result = tracker_->Track(frame);
+  static const std::vector<MarkerPoseObservation> kNoMarkers;
+  TrackingResult result = tracker_->Track(frame, world_aligned_ && fix_ ? fix_->markers : kNoMarkers);
+  if (result.state != TrackingState::kTracking && RelocalizeWithMarkers(frame, report)) {
+    result.state = TrackingState::kTracking;
+    result.num_inliers = report.num_inliers;
+  }
   report.state = result.state;
   report.num_inliers = result.num_inliers;
   if (result.state != TrackingState::kTracking) {
@@ -176,17 +216,24 @@ void System::Track(Frame& frame, FrameReport& report) {
     report.message = "tracking lost";
     ARUCOSLAM_LOG_DEBUG("frame {}: tracking lost ({} keyframes in the map)", report.index,
                         map_->NumKeyframes());
-    if (static_cast<int>(map_->NumKeyframes()) <= options_.reset_max_keyframes) ResetMap();
+    // A map aligned to the world is kept (markers relocalise into it) unless marker poses
+    // keep coming and it does not take them back.
+    const bool stuck = fix_ && ++lost_with_markers_ >= options_.marker_reset_lost_frames;
+    const bool young = static_cast<int>(map_->NumKeyframes()) <= options_.reset_max_keyframes;
+    if (stuck || (young && !world_aligned_)) {
+      ResetMap();
+    }
     return;
   }
   last_state_ = TrackingState::kTracking;
-  report.cam_from_world = frame.cam_from_world;
+  lost_with_markers_ = 0;
   ++frames_since_keyframe_;
   MaybeInsertKeyframe(frame, result.num_inliers, report);
+  report.cam_from_world = frame.cam_from_world;
   RecordPose(frame, tracker_->reference_keyframe());
 }
 
-void System::MaybeInsertKeyframe(const Frame& frame, int num_inliers, FrameReport& report) {
+void System::MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& report) {
   KeyframeDecisionInput input;
   input.frames_since_last_keyframe = frames_since_keyframe_;
   input.num_tracked = num_inliers;
@@ -212,6 +259,8 @@ void System::MaybeInsertKeyframe(const Frame& frame, int num_inliers, FrameRepor
     mapping_busy_ = true;
     queue_->Push(keyframe);
   }
+  AddAnchor(keyframe, fix_);
+  MaybeAlignWorld(&frame);
 }
 
 void System::RecordPose(const Frame& frame, KeyframeId reference) {
@@ -219,6 +268,7 @@ void System::RecordPose(const Frame& frame, KeyframeId reference) {
   pose.timestamp_s = frame.timestamp_s;
   pose.reference = reference;
   pose.cam_from_world = *frame.cam_from_world;
+  pose.in_world = world_aligned_;
   const std::optional<Rigid3> reference_pose = map_->Read([&](const MapData& data) {
     const Keyframe* keyframe = data.FindKeyframe(reference);
     return keyframe ? std::optional<Rigid3>(keyframe->cam_from_world) : std::nullopt;
@@ -231,13 +281,31 @@ void System::RecordPose(const Frame& frame, KeyframeId reference) {
 
 void System::ResetMap() {
   StopMappingThread();
+  // Poses already in the world frame stay, frozen at their current estimate.
+  std::vector<TrackedPose> kept;
+  map_->Read([&](const MapData& data) {
+    for (TrackedPose pose : poses_) {
+      if (!pose.in_world) continue;
+      if (const Keyframe* reference = data.FindKeyframe(pose.reference)) {
+        pose.cam_from_world = pose.cam_from_reference * reference->cam_from_world;
+      }
+      pose.reference = KeyframeId();
+      kept.push_back(pose);
+    }
+    return 0;
+  });
   tracker_.reset();
   mapper_.reset();
   map_ = std::make_unique<Map>();
   tracker_ = std::make_unique<Tracker>(*map_, options_.tracker);
   mapper_ = std::make_unique<LocalMapper>(*map_, options_.mapper);
-  poses_.clear();
+  poses_ = std::move(kept);
   init_reference_.reset();
+  init_reference_fix_.reset();
+  anchors_.clear();
+  next_alignment_anchors_ = 0;
+  world_aligned_ = false;
+  lost_with_markers_ = 0;
   last_state_ = TrackingState::kNotInitialized;
   mapping_busy_ = false;
   StartMappingThread();

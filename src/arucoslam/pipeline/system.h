@@ -1,5 +1,6 @@
 // System: the monocular SLAM pipeline behind one call per image: ORB extraction, map
-// initialisation, tracking, keyframe insertion and local mapping, blocking or on two threads.
+// initialisation, tracking, keyframe insertion and local mapping, blocking or on two threads;
+// with a known marker map also world anchoring, metric scale and marker relocalisation.
 #pragma once
 
 #include <Eigen/Core>
@@ -15,12 +16,16 @@
 
 #include "arucoslam/feature/orb_extractor.h"
 #include "arucoslam/map/map.h"
+#include "arucoslam/markers/camera_locator.h"
+#include "arucoslam/markers/detector.h"
+#include "arucoslam/markers/marker_map.h"
 #include "arucoslam/pipeline/bounded_queue.h"
 #include "arucoslam/slam/initializer.h"
 #include "arucoslam/slam/keyframe_policy.h"
 #include "arucoslam/slam/local_mapper.h"
 #include "arucoslam/slam/map_initialization.h"
 #include "arucoslam/slam/tracker.h"
+#include "arucoslam/slam/world_alignment.h"
 #include "arucoslam/util/timing.h"
 
 namespace arucoslam {
@@ -44,6 +49,33 @@ struct SystemOptions {
   // initialisation starts over (a young map is cheaper to rebuild than to recover).
   int reset_max_keyframes = 5;
 
+  // Known markers (markers.json). When set, markers are detected in every image and located
+  // (LocateCamera): frames without a keypoint pose get the marker pose, the keypoint map is
+  // aligned to the world (Sim3, metric scale), tracking restarts from marker poses, and
+  // aligned frames are optimised with the markers' corners. Unset: keypoints only.
+  std::optional<MarkerMap> marker_map;
+  DetectorOptions detector;
+  CameraLocatorOptions locator;
+  // Anchor outliers beyond 0.25 m: a single marker's pose at a few metres is off by 5-10 cm
+  // in rendered sequences (measured), more than WorldAlignmentOptions' 0.10 m default allows.
+  WorldAlignmentOptions alignment{0.0, 0.25, 0.05};
+  // A marker location is used only when it is not ambiguous (several markers, or one whose
+  // IPPE solutions are well separated) and its corner RMS is at most this, pixels.
+  double max_marker_rms_px = 2.0;
+  // World alignment waits for this many keyframes with a usable marker location whose
+  // camera centres span at least min_alignment_baseline_m (metres); it is refused when the
+  // anchors' residual after alignment exceeds max_alignment_rms_m (metres).
+  int min_alignment_anchors = 4;
+  double min_alignment_baseline_m = 0.5;
+  double max_alignment_rms_m = 0.15;
+  // After the first alignment, anchors keep being collected and the map is aligned again
+  // (a small Sim3 correction) each time their number doubles, up to this many anchors.
+  int max_realignment_anchors = 64;
+  // Aligned map, tracking lost for this many frames in a row while markers give poses but
+  // the map does not take them back: the map is discarded and a new one initialised and
+  // aligned (the poses already output are kept).
+  int marker_reset_lost_frames = 10;
+
   bool Check() const;
 };
 
@@ -57,6 +89,9 @@ struct FrameReport {
   int num_features = 0;
   int num_inliers = 0;
   std::string message;  // initialisation outcome or loss, for logs
+  int num_markers = 0;        // known markers detected (marker map only)
+  bool marker_pose = false;   // the pose comes from the markers alone
+  bool world_aligned = false; // the keypoint map is in the marker world frame (metric)
 };
 
 struct SystemStats {
@@ -73,6 +108,11 @@ struct SystemStats {
   int num_initializations = 0;
   int num_resets = 0;
   int num_keyframes_inserted = 0;
+  TimingStats marker_ms;          // per frame with a marker map: detection and location
+  int num_marker_frames = 0;      // frames with a usable marker location
+  int num_marker_only_poses = 0;  // frames whose pose came from markers alone
+  int num_world_alignments = 0;
+  int num_marker_relocalizations = 0;  // tracking restarted from a marker pose
 };
 
 struct StampedPose {
@@ -91,6 +131,8 @@ class System {
   FrameReport ProcessImage(const cv::Mat& grey, double timestamp_s);
   // The same from features already extracted (`undistorted` filled, camera set).
   FrameReport ProcessFrame(Frame frame);
+  // The same with the image's marker detections (distorted pixels), used with a marker map.
+  FrameReport ProcessFrame(Frame frame, const std::vector<MarkerDetection>& detections);
   // Waits until every queued keyframe is mapped and stops the mapping thread. Called by
   // the destructor; ProcessImage may not be called after it.
   void Finish();
@@ -102,6 +144,7 @@ class System {
   std::vector<Eigen::Vector3d> MapPoints() const;
   const Map& map() const { return *map_; }
   TrackingState state() const { return tracker_ ? tracker_->state() : TrackingState::kNotInitialized; }
+  bool world_aligned() const { return world_aligned_; }
   // Copy of the statistics (the mapping thread adds to local_mapping_ms).
   SystemStats Stats() const;
 
@@ -111,11 +154,30 @@ class System {
     KeyframeId reference;
     Rigid3 cam_from_reference;
     Rigid3 cam_from_world;
+    bool in_world = false;  // expressed in the marker world (kept across map resets)
+  };
+  struct MarkerAnchor {
+    KeyframeId keyframe;
+    Rigid3 world_from_cam;
+  };
+  struct MarkerFix {  // a usable marker location of the current frame
+    Rigid3 world_from_cam;
+    std::vector<MarkerPoseObservation> markers;  // its inlier markers, undistorted corners
   };
 
   void Initialize(Frame& frame, FrameReport& report);
   void Track(Frame& frame, FrameReport& report);
-  void MaybeInsertKeyframe(const Frame& frame, int num_inliers, FrameReport& report);
+  // Marker handling (system_markers.cc).
+  std::optional<MarkerFix> LocateWithMarkers(const Frame& frame,
+                                             const std::vector<MarkerDetection>& detections,
+                                             FrameReport& report);
+  bool RelocalizeWithMarkers(Frame& frame, FrameReport& report);
+  void AddAnchor(KeyframeId keyframe, const std::optional<MarkerFix>& fix);
+  // Aligns the map to the world once enough anchors exist; `frame` (the current one, its
+  // pose in the map) is carried along.
+  void MaybeAlignWorld(Frame* frame);
+  void RecordMarkerPose(const Frame& frame, FrameReport& report);
+  void MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& report);
   void MapKeyframe(KeyframeId keyframe);
   void RecordPose(const Frame& frame, KeyframeId reference);
   void ResetMap();
@@ -136,6 +198,15 @@ class System {
   TrackingState last_state_ = TrackingState::kNotInitialized;
   std::vector<TrackedPose> poses_;
   std::optional<KeyframeId> pending_keyframe_;  // blocking mode: to map after tracking
+
+  std::unique_ptr<MarkerDetector> detector_;  // with a marker map only
+  std::optional<MarkerFix> fix_;               // the current frame's
+  std::optional<MarkerFix> init_reference_fix_;
+  std::vector<MarkerAnchor> anchors_;
+  bool world_aligned_ = false;
+  int next_alignment_anchors_ = 0;  // alignment is tried again at this many anchors
+  int lost_with_markers_ = 0;
+  double detection_ms_ = 0.0;  // marker detection time of the current image
 
   std::unique_ptr<BoundedQueue<KeyframeId>> queue_;
   std::thread mapping_thread_;

@@ -17,7 +17,11 @@
 namespace arucoslam {
 
 struct RenderOptions {
-  int msaa_samples = 4;          // multisample anti-aliasing samples per pixel (1 = off)
+  // Multisample anti-aliasing samples per pixel (1 = off). It smooths only polygon
+  // silhouettes (textures, markers included, are filtered by mipmaps either way). Mesa 22's
+  // llvmpipe offers 4 samples only (2 is rounded up to 4), at about 2.7x the CPU time of
+  // no MSAA on the factory (bench/render_bench.cc).
+  int msaa_samples = 4;
   // Anisotropic texture filtering where supported (1 = off). Off by default: Mesa 22's
   // llvmpipe shifts oblique texture detail by up to 0.26 px with it (measured by
   // renderer_test's dot plane at 8x), which would bias the ground truth of marker corners.

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "arucoslam/optim/global_bundle_adjustment.h"
 #include "arucoslam/slam/synthetic_loop_map.h"
 
 namespace arucoslam {
@@ -87,6 +88,25 @@ TEST(LoopCloserTest, MetricMapClosesWithARigidTransform) {
   const double rms_after = KeyframeRms(scene);
   std::printf("metric map: keyframe RMS %.3f -> %.3f m\n", rms_before, rms_after);
   EXPECT_LT(rms_after, rms_before / 5.0);
+}
+
+// The requested global bundle adjustment then makes the whole map consistent with the
+// (exact) keypoints: lower reprojection error and keyframe error.
+TEST(LoopCloserTest, GlobalBundleAdjustmentAfterTheLoopLowersTheError) {
+  WallLoop scene;
+  Build(scene);
+  LoopCloser closer(scene.map);
+  ASSERT_TRUE(closer.CloseLoop(scene.keyframes.back(), scene.keyframes[0]).closed);
+  ASSERT_TRUE(closer.global_bundle_adjustment_requested());
+  const double rms_loop = KeyframeRms(scene);
+  const GlobalBundleAdjustmentResult result = RunGlobalBundleAdjustment(scene.map);
+  ASSERT_TRUE(result.applied) << result.summary.message;
+  const double rms_global = KeyframeRms(scene);
+  std::printf("global BA: %s; keyframe RMS %.3f -> %.3f m\n", result.summary.BriefReport().c_str(),
+              rms_loop, rms_global);
+  EXPECT_LT(result.summary.final_rms_px, 0.5 * result.summary.initial_rms_px);
+  EXPECT_LT(rms_global, rms_loop);
+  EXPECT_EQ(scene.map.Read([](const MapData& data) { return data.CheckInvariants(); }), "");
 }
 
 TEST(LoopCloserTest, RejectsKeyframesThatDoNotOverlap) {

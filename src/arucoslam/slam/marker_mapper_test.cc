@@ -55,16 +55,16 @@ void Build(MappedScene& scene, const Sim3& estimate_from_true, double drift,
     Vector6d delta;
     for (int c = 0; c < 3; ++c) delta[c] = drift * normal(random);
     for (int c = 3; c < 6; ++c) delta[c] = 0.5 * drift * normal(random);
-    const Rigid3 world_from_cam = estimate_from_true.TransformPose(
-        scene.truth.keypoints.poses[i].cam_from_world.Inverse());
+    const Rigid3 world_from_cam =
+        estimate_from_true.TransformPose(scene.truth.keypoints.poses[i].cam_from_world.Inverse());
     keyframe.cam_from_world = Rigid3::Exp(delta) * world_from_cam.Inverse();
     for (const auto& observation : scene.truth.keypoints.observations) {
       if (observation.pose_index != i) continue;
       cv::KeyPoint keypoint(observation.pixel.x(), observation.pixel.y(), 31.0f);
       keypoint.octave = 0;
       keyframe.features.keypoints.push_back(keypoint);
-      keyframe.features.undistorted.push_back(
-          Eigen::Vector2d((observation.pixel.x() - k.cx) / k.fx, (observation.pixel.y() - k.cy) / k.fy));
+      keyframe.features.undistorted.push_back(Eigen::Vector2d(
+          (observation.pixel.x() - k.cx) / k.fx, (observation.pixel.y() - k.cy) / k.fy));
       keyframe.map_point_ids.push_back(points[observation.point_index]);
     }
     keyframe.features.descriptors =
@@ -73,8 +73,8 @@ void Build(MappedScene& scene, const Sim3& estimate_from_true, double drift,
     std::vector<MarkerObservation> seen;
     for (const auto& observation : scene.truth.marker_observations) {
       if (observation.pose_index != i) continue;
-      seen.push_back({MarkerId(static_cast<int>(observation.marker_index)),
-                      observation.corners_px});
+      seen.push_back(
+          {MarkerId(static_cast<int>(observation.marker_index)), observation.corners_px});
     }
     scene.markers.push_back(seen);
   }
@@ -100,15 +100,17 @@ double PositionError(const MarkerLandmark& landmark, const MarkerBundleAdjustmen
 
 void AddAll(MappedScene& scene, MarkerMapper& mapper) {
   for (std::size_t i = 0; i < scene.keyframes.size(); ++i) {
-    mapper.AddKeyframe(scene.keyframes[i], scene.map.FindKeyframe(scene.keyframes[i])->cam_from_world,
-                       scene.camera, scene.markers[i]);
+    mapper.AddKeyframe(scene.keyframes[i],
+                       scene.map.FindKeyframe(scene.keyframes[i])->cam_from_world, scene.camera,
+                       scene.markers[i]);
   }
 }
 
 TEST(MarkerMapperTest, AllButOneMarkerUnknownAreMappedWithinThreeCentimetres) {
   MappedScene scene;
-  Build(scene, Sim3(1.02, Eigen::Quaterniond(Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitZ())),
-                    Eigen::Vector3d(0.03, -0.02, 0.01)),
+  Build(scene,
+        Sim3(1.02, Eigen::Quaterniond(Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitZ())),
+             Eigen::Vector3d(0.03, -0.02, 0.01)),
         0.004);
   MarkerMapper mapper(KnownMap(scene.truth));
   AddAll(scene, mapper);

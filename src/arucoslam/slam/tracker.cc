@@ -1,6 +1,7 @@
 #include "arucoslam/slam/tracker.h"
 
 #include <algorithm>
+#include <limits>
 #include <map>
 #include <set>
 #include <vector>
@@ -27,7 +28,9 @@ bool TrackerOptions::Check() const {
   return motion_search.Check() && min_motion_matches >= 0 && reference_search.Check() &&
          min_reference_matches >= 0 && covisible_per_keyframe >= 0 && max_local_keyframes >= 1 &&
          local_map_search.Check() && min_view_cos >= -1.0 && min_view_cos <= 1.0 &&
-         min_pose_inliers >= 3 && min_local_map_inliers >= min_pose_inliers && pose.Check();
+         min_pose_inliers >= 3 && min_local_map_inliers >= min_pose_inliers && pose.Check() &&
+         marker_pose.Check() && relocalization_min_axis_cos >= -1.0 &&
+         relocalization_min_axis_cos <= 1.0;
 }
 
 Tracker::Tracker(Map& map, const TrackerOptions& options) : map_(map), options_(options) {}
@@ -46,7 +49,12 @@ void Tracker::Reset() {
   state_ = TrackingState::kNotInitialized;
 }
 
-TrackingResult Tracker::Track(Frame& frame) {
+TrackingResult Tracker::Track(Frame& frame, const std::vector<MarkerPoseObservation>& markers) {
+  markers_ = &markers;
+  struct Clear {
+    const std::vector<MarkerPoseObservation>** markers;
+    ~Clear() { *markers = nullptr; }
+  } clear{&markers_};
   TrackingResult result;
   result.state = state_;
   if (state_ == TrackingState::kNotInitialized || !last_frame_) return result;
@@ -128,6 +136,86 @@ bool Tracker::TrackReferenceKeyframe(Frame& frame, TrackingResult& result) {
   return result.num_initial_inliers >= options_.min_pose_inliers;
 }
 
+TrackingResult Tracker::TrackFromPose(Frame& frame, const Rigid3& cam_from_world,
+                                      const std::vector<MarkerPoseObservation>& markers) {
+  markers_ = &markers;
+  struct Clear {
+    const std::vector<MarkerPoseObservation>** markers;
+    ~Clear() { *markers = nullptr; }
+  } clear{&markers_};
+  TrackingResult result;
+  result.state = state_;
+  const KeyframeId nearest = NearestKeyframe(cam_from_world);
+  if (!nearest.IsValid()) return result;
+  frame.ResetMatches();
+  ProjectionQueries set;
+  map_.Read([&](const MapData& data) {
+    const Keyframe& keyframe = *data.FindKeyframe(nearest);
+    for (std::size_t i = 0; i < keyframe.map_point_ids.size(); ++i) {
+      const MapPoint* point = data.FindMapPoint(keyframe.map_point_ids[i]);
+      if (point == nullptr) continue;
+      const std::optional<Eigen::Vector2d> pixel =
+          frame.camera.Project(cam_from_world * point->p_in_world);
+      if (!pixel || !frame.camera.InImage(*pixel)) continue;
+      const cv::KeyPoint& keypoint = keyframe.features.keypoints[i];
+      set.Add(point->id, *pixel, keypoint.octave, point->descriptor, 1.0, keypoint.angle);
+    }
+  });
+  set.Finalize();
+  ProjectionMatchOptions wide = options_.motion_search;
+  wide.base_radius_px *= 2.0;
+  const std::vector<FeatureMatch> matches =
+      MatchByProjection(frame.features, FeatureGrid(frame.features), set.queries, {}, wide);
+  result.num_initial_matches = static_cast<int>(matches.size());
+  frame.cam_from_world.reset();
+  if (result.num_initial_matches < options_.min_motion_matches) return result;
+  set.AssignTo(matches, frame);
+  result.num_initial_inliers = OptimizeFramePose(frame, cam_from_world);
+  result.method = "pose";
+  if (result.num_initial_inliers < options_.min_pose_inliers ||
+      !TrackLocalMap(frame, result)) {
+    frame.cam_from_world.reset();
+    frame.ResetMatches();
+    result.method.clear();
+    return result;
+  }
+  last_frame_ = frame;
+  velocity_.reset();
+  state_ = TrackingState::kTracking;
+  result.state = state_;
+  return result;
+}
+
+KeyframeId Tracker::NearestKeyframe(const Rigid3& cam_from_world) const {
+  const Rigid3 world_from_cam = cam_from_world.Inverse();
+  const Eigen::Vector3d axis = world_from_cam.rotation * Eigen::Vector3d::UnitZ();
+  return map_.Read([&](const MapData& data) {
+    KeyframeId best;
+    double best_distance = std::numeric_limits<double>::infinity();
+    for (const auto& [id, keyframe] : data.keyframes()) {
+      const Rigid3 world_from_keyframe = keyframe.cam_from_world.Inverse();
+      const Eigen::Vector3d keyframe_axis =
+          world_from_keyframe.rotation * Eigen::Vector3d::UnitZ();
+      if (axis.dot(keyframe_axis) < options_.relocalization_min_axis_cos) continue;
+      const double distance =
+          (world_from_keyframe.translation - world_from_cam.translation).norm();
+      if (distance < best_distance) {
+        best_distance = distance;
+        best = id;
+      }
+    }
+    return best;
+  });
+}
+
+void Tracker::ApplySimilarity(const Sim3& world_from_map) {
+  if (last_frame_ && last_frame_->cam_from_world) {
+    last_frame_->cam_from_world =
+        world_from_map.TransformPose(last_frame_->cam_from_world->Inverse()).Inverse();
+  }
+  if (velocity_) velocity_->translation *= world_from_map.scale;
+}
+
 int Tracker::OptimizeFramePose(Frame& frame, const Rigid3& initial) {
   std::vector<PoseObservation> observations;
   std::vector<int> keypoint_of;
@@ -146,8 +234,20 @@ int Tracker::OptimizeFramePose(Frame& frame, const Rigid3& initial) {
   });
   PoseOptimizationOptions pose_options = options_.pose;
   pose_options.min_inliers = options_.min_pose_inliers;
-  const PoseOptimizationResult optimized = OptimizePose(
-      observations, initial, PinholeIntrinsics::FromCamera(frame.camera), pose_options);
+  const PinholeIntrinsics intrinsics = PinholeIntrinsics::FromCamera(frame.camera);
+  PoseOptimizationResult optimized;
+  if (markers_ != nullptr && !markers_->empty()) {
+    MarkerPoseOptimizationOptions marker_options = options_.marker_pose;
+    marker_options.keypoints = pose_options;
+    const MarkerPoseOptimizationResult fused =
+        OptimizePoseWithMarkers(observations, *markers_, initial, intrinsics, marker_options);
+    optimized.success = fused.success;
+    optimized.cam_from_world = fused.cam_from_world;
+    optimized.inliers = fused.inliers;
+    optimized.num_inliers = fused.num_inliers;
+  } else {
+    optimized = OptimizePose(observations, initial, intrinsics, pose_options);
+  }
   if (!optimized.success) return 0;
   frame.cam_from_world = optimized.cam_from_world;
   for (std::size_t k = 0; k < observations.size(); ++k) {

@@ -4,10 +4,13 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "arucoslam/feature/orb_matcher.h"
 #include "arucoslam/map/frame.h"
 #include "arucoslam/map/map.h"
+#include "arucoslam/geometry/sim3.h"
+#include "arucoslam/optim/marker_pose_optimizer.h"
 #include "arucoslam/optim/pose_optimizer.h"
 
 namespace arucoslam {
@@ -38,6 +41,12 @@ struct TrackerOptions {
   int min_pose_inliers = 10;
   int min_local_map_inliers = 30;
   PoseOptimizationOptions pose;
+  // Marker-corner residuals used with the keypoints when known markers are given to Track
+  // (their keypoint part is `pose`, overwritten here).
+  MarkerPoseOptimizationOptions marker_pose;
+  // TrackFromPose: the keyframe nearest the given pose whose optical axis is within this
+  // angle's cosine of the camera's (about 60 degrees) gives the points to project.
+  double relocalization_min_axis_cos = 0.5;
 
   bool Check() const;
 };
@@ -65,7 +74,17 @@ class Tracker {
 
   // Tracks `frame` (features with `undistorted` filled, camera set). On success fills
   // frame.cam_from_world and frame.map_point_ids (outlier matches removed).
-  TrackingResult Track(Frame& frame);
+  // `markers`: known (fixed) markers seen in the frame, in the map's world frame; when not
+  // empty every pose optimisation uses their corners with the keypoints.
+  TrackingResult Track(Frame& frame, const std::vector<MarkerPoseObservation>& markers = {});
+  // Relocalisation from an outside pose (e.g. markers): the nearest keyframe's points are
+  // projected with `cam_from_world`, matched, the pose optimised and the local map tracked.
+  // On success tracking resumes (state kTracking); on failure the state is unchanged.
+  TrackingResult TrackFromPose(Frame& frame, const Rigid3& cam_from_world,
+                               const std::vector<MarkerPoseObservation>& markers = {});
+  // After the map was moved by world_from_map (world alignment): the last pose and the
+  // velocity are carried into the new frame and scale.
+  void ApplySimilarity(const Sim3& world_from_map);
 
   TrackingState state() const { return state_; }
   KeyframeId reference_keyframe() const { return reference_keyframe_; }
@@ -79,6 +98,8 @@ class Tracker {
   // Pose-only optimisation over the frame's matches from `initial`; drops outlier matches
   // and returns the number of inliers (0 when it failed).
   int OptimizeFramePose(Frame& frame, const Rigid3& initial);
+  // The keyframe nearest `cam_from_world` facing about the same way (invalid when none).
+  KeyframeId NearestKeyframe(const Rigid3& cam_from_world) const;
 
   Map& map_;
   TrackerOptions options_;
@@ -86,6 +107,7 @@ class Tracker {
   std::optional<Frame> last_frame_;
   std::optional<Rigid3> velocity_;
   KeyframeId reference_keyframe_;
+  const std::vector<MarkerPoseObservation>* markers_ = nullptr;  // during Track only
 };
 
 }  // namespace arucoslam

@@ -77,8 +77,7 @@ double Residual(const WeightedAnchor& anchor, const Sim3& world_from_map) {
 // The fit with every usable anchor, or without the one whose removal fits the rest best
 // when some anchor misses the threshold (three or more anchors).
 std::optional<Sim3> RobustFit(const std::vector<WeightedAnchor>& anchors, std::vector<bool>* use,
-                              const WorldAlignmentOptions& options,
-                              WorldAlignmentMethod* method) {
+                              const WorldAlignmentOptions& options, WorldAlignmentMethod* method) {
   const auto worst = [&](const Sim3& fit, const std::vector<bool>& subset) {
     double value = 0.0;
     for (std::size_t i = 0; i < anchors.size(); ++i) {
@@ -117,9 +116,11 @@ WorldAlignment SingleAnchor(const WorldAnchor& anchor) {
   }
   const double scale = anchor.marker_depth_m / anchor.marker_depth_in_map;
   const Rigid3 map_from_cam = anchor.cam_from_map.Inverse();
-  const Eigen::Quaterniond rotation = anchor.world_from_cam.rotation * map_from_cam.rotation.inverse();
-  result.world_from_map = Sim3(scale, rotation, anchor.world_from_cam.translation -
-                                                    scale * (rotation * map_from_cam.translation));
+  const Eigen::Quaterniond rotation =
+      anchor.world_from_cam.rotation * map_from_cam.rotation.inverse();
+  result.world_from_map =
+      Sim3(scale, rotation,
+           anchor.world_from_cam.translation - scale * (rotation * map_from_cam.translation));
   result.method = WorldAlignmentMethod::kSingleAnchor;
   result.success = true;
   return result;
@@ -136,10 +137,10 @@ WorldAlignment EstimateWorldFromMap(const std::vector<WorldAnchor>& anchors,
   for (const WorldAnchor& anchor : anchors) {
     const Rigid3 map_from_cam = anchor.cam_from_map.Inverse();
     const double weight = anchor.ambiguous ? options.ambiguous_weight : 1.0;
-    weighted.push_back({map_from_cam.translation, anchor.world_from_cam.translation,
-                        (anchor.world_from_cam.rotation * map_from_cam.rotation.inverse())
-                            .toRotationMatrix(),
-                        weight});
+    weighted.push_back(
+        {map_from_cam.translation, anchor.world_from_cam.translation,
+         (anchor.world_from_cam.rotation * map_from_cam.rotation.inverse()).toRotationMatrix(),
+         weight});
     use.push_back(weight > 0.0);
   }
   const int usable = static_cast<int>(std::count(use.begin(), use.end(), true));
@@ -176,14 +177,16 @@ WorldAlignment EstimateWorldFromMap(const std::vector<WorldAnchor>& anchors,
   }
   result.rms_m = result.num_inliers > 0 ? std::sqrt(sum / result.num_inliers) : 0.0;
   result.success = result.num_inliers >= 2;
-  if (!result.success) result.failure = "the marker poses disagree with the map beyond the threshold";
+  if (!result.success)
+    result.failure = "the marker poses disagree with the map beyond the threshold";
   return result;
 }
 
 void ApplyWorldAlignment(const Sim3& world_from_map, MapData* map, MarkerLandmarks* markers) {
   std::vector<std::pair<KeyframeId, Rigid3>> poses;
   for (const auto& [id, keyframe] : map->keyframes()) {
-    poses.emplace_back(id, world_from_map.TransformPose(keyframe.cam_from_world.Inverse()).Inverse());
+    poses.emplace_back(id,
+                       world_from_map.TransformPose(keyframe.cam_from_world.Inverse()).Inverse());
   }
   for (const auto& [id, pose] : poses) map->SetKeyframePose(id, pose);
   std::vector<MapPointId> points;

@@ -35,8 +35,8 @@ struct WorldAlignmentOptions {
   // alignment is an outlier (metres, world frame).
   double outlier_threshold_m = 0.10;
   // The map's camera centres are treated as collinear when the second eigenvalue of their
-  // scatter (a squared spread) is below this fraction of the first; the rotation about that line then
-  // comes from averaging the anchors' orientations instead of from the centres alone.
+  // scatter (a squared spread) is below this fraction of the first; the rotation about that line
+  // then comes from averaging the anchors' orientations instead of from the centres alone.
   double collinear_ratio = 0.05;
 
   bool Check() const {
@@ -47,9 +47,9 @@ struct WorldAlignmentOptions {
 
 enum class WorldAlignmentMethod {
   kNone,
-  kCentres,                  // weighted Umeyama over >= 3 non-collinear camera centres
-  kOrientationsAndCentres,   // rotation averaged from anchor orientations; scale, shift from centres
-  kSingleAnchor,             // one pose plus the marker's depth ratio for the scale
+  kCentres,                 // weighted Umeyama over >= 3 non-collinear camera centres
+  kOrientationsAndCentres,  // rotation averaged from anchor orientations; scale, shift from centres
+  kSingleAnchor,            // one pose plus the marker's depth ratio for the scale
 };
 
 struct WorldAlignment {

@@ -5,14 +5,16 @@
 #include <cmath>
 #include <random>
 
+#include "arucoslam/markers/camera_locator.h"
 #include "arucoslam/optim/marker_bundle_adjustment_synthetic.h"
 
 namespace arucoslam {
 namespace {
 
 // The map frame of a monocular run: anything, at a third of the metric scale.
-const Sim3 kMapFromWorld(0.37, Eigen::Quaterniond(Eigen::AngleAxisd(1.1, Eigen::Vector3d(0.3, -0.5, 0.8).normalized())),
-                         Eigen::Vector3d(2.0, -1.0, 0.5));
+const Sim3 kMapFromWorld(
+    0.37, Eigen::Quaterniond(Eigen::AngleAxisd(1.1, Eigen::Vector3d(0.3, -0.5, 0.8).normalized())),
+    Eigen::Vector3d(2.0, -1.0, 0.5));
 
 Rigid3 Noisy(const Rigid3& pose, double translation_m, double rotation_rad, std::mt19937& random) {
   std::normal_distribution<double> normal(0.0, 1.0);
@@ -30,8 +32,7 @@ std::vector<WorldAnchor> Anchors(const std::vector<Rigid3>& true_cam_from_world,
   for (std::size_t i = 0; i < true_cam_from_world.size(); i += step) {
     WorldAnchor anchor;
     anchor.keyframe = KeyframeId(i);
-    anchor.cam_from_map =
-        kMapFromWorld.TransformPose(true_cam_from_world[i].Inverse()).Inverse();
+    anchor.cam_from_map = kMapFromWorld.TransformPose(true_cam_from_world[i].Inverse()).Inverse();
     anchor.world_from_cam = Noisy(true_cam_from_world[i].Inverse(), 0.01, 0.009, random);
     anchors.push_back(anchor);
   }
@@ -82,9 +83,10 @@ TEST(WorldAlignmentTest, AmbiguousPosesAreLeftOutByDefault) {
   // Two ambiguous anchors carry IPPE's other solution: the camera mirrored about the marker.
   for (int i : {1, 4}) {
     anchors[i].ambiguous = true;
-    anchors[i].world_from_cam = Rigid3(anchors[i].world_from_cam.rotation *
-                                           Eigen::Quaterniond(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitY())),
-                                       anchors[i].world_from_cam.translation + Eigen::Vector3d(0.0, 0.6, 0.0));
+    anchors[i].world_from_cam =
+        Rigid3(anchors[i].world_from_cam.rotation *
+                   Eigen::Quaterniond(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitY())),
+               anchors[i].world_from_cam.translation + Eigen::Vector3d(0.0, 0.6, 0.0));
   }
   const WorldAlignment alignment = EstimateWorldFromMap(anchors);
   ExpectRecovers(alignment, CorridorPoses(), 0.02);
@@ -95,8 +97,8 @@ TEST(WorldAlignmentTest, AmbiguousPosesAreLeftOutByDefault) {
 TEST(WorldAlignmentTest, AnLShapedPathTakesItsRotationFromCentres) {
   std::vector<Rigid3> poses;
   for (int i = 0; i < 10; ++i) {
-    const Eigen::Vector3d centre = i < 5 ? Eigen::Vector3d(0.6 * i, 0.0, 1.0)
-                                         : Eigen::Vector3d(2.4, 0.6 * (i - 4), 1.0);
+    const Eigen::Vector3d centre =
+        i < 5 ? Eigen::Vector3d(0.6 * i, 0.0, 1.0) : Eigen::Vector3d(2.4, 0.6 * (i - 4), 1.0);
     poses.push_back(Rigid3(Eigen::Quaterniond::Identity(), centre).Inverse());
   }
   const WorldAlignment alignment = EstimateWorldFromMap(Anchors(poses, 1));
@@ -185,10 +187,93 @@ TEST(WorldAlignmentTest, ApplyMovesKeyframesPointsAndMappedMarkers) {
   EXPECT_LT(RotationAngle(moved.rotation * true_cam_from_world.rotation.inverse()), 1e-12);
   EXPECT_LT((map.FindMapPoint(point_id)->p_in_world - p_in_world).norm(), 1e-12);
   EXPECT_EQ(markers.Find(MarkerId(1))->world_from_marker.translation, Eigen::Vector3d(3, 0, 1));
-  EXPECT_LT((markers.Find(MarkerId(2))->world_from_marker.translation - Eigen::Vector3d(3, 0, 1))
-                .norm(),
-            1e-12);
+  EXPECT_LT(
+      (markers.Find(MarkerId(2))->world_from_marker.translation - Eigen::Vector3d(3, 0, 1)).norm(),
+      1e-12);
   EXPECT_EQ(map.CheckInvariants(), "");
+}
+
+// The pieces together on a monocular map at a third of the metric scale: camera poses from
+// LocateCamera on the marker corners, the Sim(3) from them, then bundle adjustment with the
+// markers fixed. The result is metric and in the world frame.
+TEST(WorldAlignmentTest, LocatedCamerasAlignAndBundleAdjustmentMakesTheMapMetric) {
+  SyntheticMarkerSceneOptions scene_options;
+  scene_options.noise_px = 0.5;
+  scene_options.corner_noise_px = 0.3;
+  const MarkerBundleAdjustmentProblem truth = MakeSyntheticMarkerScene(scene_options);
+  CameraModel camera;
+  camera.width = scene_options.image_width;
+  camera.height = scene_options.image_height;
+  camera.fx = truth.keypoints.intrinsics.fx;
+  camera.fy = truth.keypoints.intrinsics.fy;
+  camera.cx = truth.keypoints.intrinsics.cx;
+  camera.cy = truth.keypoints.intrinsics.cy;
+  MarkerMap known;
+  for (std::size_t m = 0; m < truth.markers.size(); ++m) {
+    MarkerInfo info;
+    info.id = static_cast<int>(m);
+    info.size = truth.markers[m].size;
+    info.world_from_marker = truth.markers[m].world_from_marker;
+    known.markers[info.id] = info;
+  }
+  // The keypoint map: the truth in the map frame with 5 mm / 0.15 degree of drift per pose.
+  MarkerBundleAdjustmentProblem problem = truth;
+  std::mt19937 random(21);
+  for (auto& pose : problem.keypoints.poses) {
+    const Rigid3 map_from_cam = kMapFromWorld.TransformPose(pose.cam_from_world.Inverse());
+    pose.cam_from_world = Noisy(map_from_cam, 0.005 * 0.37, 0.0026, random).Inverse();
+  }
+  for (auto& point : problem.keypoints.points) point.p_in_world = kMapFromWorld * point.p_in_world;
+
+  std::vector<WorldAnchor> anchors;
+  for (std::size_t pose = 0; pose < truth.keypoints.poses.size(); ++pose) {
+    std::vector<MarkerDetection> detections;
+    for (const auto& observation : truth.marker_observations) {
+      if (observation.pose_index != pose) continue;
+      MarkerDetection detection;
+      detection.id = static_cast<int>(observation.marker_index);
+      detection.corners = observation.corners_px;
+      detections.push_back(detection);
+    }
+    const CameraLocation location = LocateCamera(detections, known, camera);
+    if (!location.found) continue;
+    WorldAnchor anchor;
+    anchor.keyframe = KeyframeId(pose);
+    anchor.cam_from_map = problem.keypoints.poses[pose].cam_from_world;
+    anchor.world_from_cam = location.world_from_cam;
+    anchor.ambiguous = location.quality.ambiguous;
+    anchors.push_back(anchor);
+  }
+  ASSERT_GE(anchors.size(), 5u);
+  const WorldAlignment alignment = EstimateWorldFromMap(anchors);
+  ASSERT_TRUE(alignment.success) << alignment.failure;
+  EXPECT_NEAR((alignment.world_from_map * kMapFromWorld).scale, 1.0, 0.01);
+
+  for (auto& pose : problem.keypoints.poses) {
+    pose.cam_from_world =
+        alignment.world_from_map.TransformPose(pose.cam_from_world.Inverse()).Inverse();
+  }
+  for (auto& point : problem.keypoints.points) {
+    point.p_in_world = alignment.world_from_map * point.p_in_world;
+  }
+  MarkerBundleAdjustmentOptions options;
+  options.solver.max_iterations = 50;
+  const MarkerBundleAdjustmentSummary summary = SolveMarkerBundleAdjustment(options, &problem);
+  ASSERT_TRUE(summary.success) << summary.message;
+  double worst = 0.0;
+  for (std::size_t i = 0; i < truth.keypoints.poses.size(); ++i) {
+    worst = std::max(worst, (problem.keypoints.poses[i].cam_from_world.Inverse().translation -
+                             truth.keypoints.poses[i].cam_from_world.Inverse().translation)
+                                .norm());
+  }
+  EXPECT_LT(worst, 0.02) << summary.BriefReport();
+  const auto centre = [](const MarkerBundleAdjustmentProblem& p, std::size_t i) {
+    return p.keypoints.poses[i].cam_from_world.Inverse().translation;
+  };
+  const std::size_t last = truth.keypoints.poses.size() - 1;
+  EXPECT_NEAR((centre(problem, last) - centre(problem, 0)).norm() /
+                  (centre(truth, last) - centre(truth, 0)).norm(),
+              1.0, 0.01);
 }
 
 }  // namespace

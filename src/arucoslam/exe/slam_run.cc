@@ -1,0 +1,91 @@
+#include "arucoslam/exe/slam_run.h"
+
+#include <fmt/format.h>
+
+#include <cstdio>
+
+#include "arucoslam/util/files.h"
+#include "arucoslam/util/timing.h"
+
+namespace arucoslam {
+namespace {
+
+Trajectory ToTrajectory(const std::vector<StampedPose>& poses) {
+  Trajectory trajectory;
+  for (const StampedPose& pose : poses) trajectory.Add(pose.timestamp_s, pose.world_from_cam);
+  return trajectory;
+}
+
+SlamRunStats MakeStats(const std::string& dataset_label, const Dataset& dataset,
+                       const System& system, bool blocking, bool markers, double wall_time_s) {
+  const SystemStats stats = system.Stats();
+  SlamRunStats out;
+  out.dataset = dataset_label;
+  out.layout = DatasetLayoutName(dataset.layout());
+  out.blocking = blocking;
+  out.markers = markers;
+  out.frames = stats.num_frames;
+  out.frames_tracked = stats.num_tracked;
+  out.frames_lost = stats.num_lost;
+  out.losses = stats.num_losses;
+  out.initialization_attempts = stats.num_initialization_attempts;
+  out.initializations = stats.num_initializations;
+  out.resets = stats.num_resets;
+  out.keyframes_inserted = stats.num_keyframes_inserted;
+  out.keyframes = static_cast<int>(system.map().NumKeyframes());
+  out.map_points = static_cast<int>(system.map().NumMapPoints());
+  out.wall_time_s = wall_time_s;
+  out.peak_memory_bytes = PeakMemoryBytes();
+  out.timings_ms = {{"extraction", stats.extraction_ms.Summarize()},
+                    {"tracking", stats.tracking_ms.Summarize()},
+                    {"frame", stats.frame_ms.Summarize()},
+                    {"local_mapping", stats.local_mapping_ms.Summarize()}};
+  return out;
+}
+
+}  // namespace
+
+SlamRunResult RunSlamOnDataset(const Dataset& dataset, const std::string& dataset_label,
+                               const SystemOptions& options, bool markers,
+                               const std::filesystem::path& out_dir, bool progress) {
+  StagedDirectory staged(out_dir);
+  const Stopwatch wall;
+  System system(dataset.camera(), options);
+  for (std::size_t i = 0; i < dataset.size(); ++i) {
+    const FrameReport report =
+        system.ProcessImage(dataset.LoadImage(i), dataset.frame(i).timestamp_s);
+    if (progress && (i % 10 == 0 || i + 1 == dataset.size())) {
+      std::fprintf(stderr, "\rframe %zu/%zu  %-15s keyframes %zu  points %zu", i + 1,
+                   dataset.size(), TrackingStateName(report.state).c_str(),
+                   system.map().NumKeyframes(), system.map().NumMapPoints());
+      std::fflush(stderr);
+    }
+  }
+  system.Finish();
+  if (progress) std::fprintf(stderr, "\n");
+  SlamRunResult result;
+  result.stats =
+      MakeStats(dataset_label, dataset, system, options.blocking, markers, wall.ElapsedSeconds());
+  result.trajectory = ToTrajectory(system.Trajectory());
+  result.keyframes = ToTrajectory(system.KeyframePoses());
+  result.timing = system.Stats();
+  WriteSlamOutput(staged.path(), result.trajectory, result.keyframes, system.MapPoints(),
+                  result.stats);
+  staged.Commit();
+  return result;
+}
+
+std::string SlamRunSummary(const SlamRunResult& result, const std::string& out_dir) {
+  const SlamRunStats& stats = result.stats;
+  std::string line = fmt::format(
+      "{} frames, {} tracked ({:.1f}%), {} losses, {} keyframes, {} points; tracking median "
+      "{:.1f} ms, local mapping median {:.1f} ms; {:.1f} s -> {}",
+      stats.frames, stats.frames_tracked,
+      stats.frames > 0 ? 100.0 * stats.frames_tracked / stats.frames : 0.0, stats.losses,
+      stats.keyframes, stats.map_points, result.timing.tracking_ms.Summarize().median,
+      result.timing.local_mapping_ms.Summarize().median, stats.wall_time_s, out_dir);
+  if (stats.initializations == 0) line += "\nmap not initialised (no camera motion found)";
+  return line;
+}
+
+}  // namespace arucoslam

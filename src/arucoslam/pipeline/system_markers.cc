@@ -1,0 +1,159 @@
+// System's marker handling: locating each frame in the known marker map, marker-only poses,
+// relocalisation from a marker pose, and the Sim(3) alignment of the keypoint map to the world.
+#include <algorithm>
+#include <utility>
+
+#include "arucoslam/pipeline/system.h"
+#include "arucoslam/util/logging.h"
+
+namespace arucoslam {
+namespace {
+
+Eigen::Vector2d UndistortedPixel(const CameraModel& camera, const Eigen::Vector2d& pixel) {
+  const Eigen::Vector2d normalised = camera.Unproject(pixel);
+  return {camera.fx * normalised.x() + camera.cx, camera.fy * normalised.y() + camera.cy};
+}
+
+// Largest distance between two anchors' camera centres, metres.
+double Baseline(const std::vector<WorldAnchor>& anchors) {
+  double baseline = 0.0;
+  for (std::size_t i = 0; i < anchors.size(); ++i) {
+    for (std::size_t j = i + 1; j < anchors.size(); ++j) {
+      baseline = std::max(baseline, (anchors[i].world_from_cam.translation -
+                                     anchors[j].world_from_cam.translation).norm());
+    }
+  }
+  return baseline;
+}
+
+}  // namespace
+
+std::optional<System::MarkerFix> System::LocateWithMarkers(
+    const Frame& frame, const std::vector<MarkerDetection>& detections, FrameReport& report) {
+  if (!options_.marker_map) return std::nullopt;
+  const Stopwatch watch;
+  const MarkerMap& known = *options_.marker_map;
+  const CameraLocation location = LocateCamera(detections, known, camera_, options_.locator);
+  report.num_markers = static_cast<int>(location.marker_ids.size());
+  std::optional<MarkerFix> fix;
+  if (location.found && !location.quality.ambiguous &&
+      location.quality.reprojection_rms_px <= options_.max_marker_rms_px) {
+    fix.emplace();
+    fix->world_from_cam = location.world_from_cam;
+    for (const MarkerDetection& detection : detections) {
+      if (!std::binary_search(location.marker_ids.begin(), location.marker_ids.end(),
+                              detection.id)) {
+        continue;
+      }
+      const MarkerInfo* info = known.Find(detection.id);
+      MarkerPoseObservation observation;
+      observation.world_from_marker = info->world_from_marker;
+      observation.size = info->size;
+      for (int c = 0; c < 4; ++c) {
+        observation.corners_px[c] = UndistortedPixel(frame.camera, detection.corners[c]);
+      }
+      fix->markers.push_back(observation);
+    }
+  }
+  std::lock_guard lock(stats_mutex_);
+  stats_.marker_ms.Add(detection_ms_ + watch.ElapsedMilliseconds());
+  detection_ms_ = 0.0;
+  if (fix) ++stats_.num_marker_frames;
+  return fix;
+}
+
+bool System::RelocalizeWithMarkers(Frame& frame, FrameReport& report) {
+  if (!world_aligned_ || !fix_) return false;
+  const TrackingResult result =
+      tracker_->TrackFromPose(frame, fix_->world_from_cam.Inverse(), fix_->markers);
+  if (result.state != TrackingState::kTracking) return false;
+  report.num_inliers = result.num_inliers;
+  report.message = "relocalised from markers";
+  ARUCOSLAM_LOG_DEBUG("frame {}: relocalised from markers, {} inliers", report.index,
+                      result.num_inliers);
+  std::lock_guard lock(stats_mutex_);
+  ++stats_.num_marker_relocalizations;
+  return true;
+}
+
+void System::AddAnchor(KeyframeId keyframe, const std::optional<MarkerFix>& fix) {
+  if (!fix || !keyframe.IsValid()) return;
+  if (world_aligned_ && next_alignment_anchors_ > options_.max_realignment_anchors) return;
+  anchors_.push_back({keyframe, fix->world_from_cam});
+}
+
+void System::MaybeAlignWorld(Frame* frame) {
+  const int needed = std::max(options_.min_alignment_anchors, next_alignment_anchors_);
+  if (static_cast<int>(anchors_.size()) < needed) return;
+  std::vector<WorldAnchor> anchors;
+  std::vector<MarkerAnchor> live;  // anchors whose keyframe is still in the map
+  map_->Read([&](const MapData& data) {
+    for (const MarkerAnchor& anchor : anchors_) {
+      const Keyframe* keyframe = data.FindKeyframe(anchor.keyframe);
+      if (keyframe == nullptr) continue;
+      live.push_back(anchor);
+      WorldAnchor world_anchor;
+      world_anchor.keyframe = anchor.keyframe;
+      world_anchor.cam_from_map = keyframe->cam_from_world;
+      world_anchor.world_from_cam = anchor.world_from_cam;
+      anchors.push_back(world_anchor);
+    }
+    return 0;
+  });
+  anchors_ = std::move(live);
+  if (static_cast<int>(anchors.size()) < needed ||
+      Baseline(anchors) < options_.min_alignment_baseline_m) {
+    return;
+  }
+  const WorldAlignment alignment = EstimateWorldFromMap(anchors, options_.alignment);
+  if (!alignment.success || alignment.rms_m > options_.max_alignment_rms_m) {
+    ARUCOSLAM_LOG_DEBUG("world alignment refused ({} anchors): {} rms {:.3f} m", anchors.size(),
+                        alignment.failure, alignment.rms_m);
+    return;
+  }
+  const Sim3& world_from_map = alignment.world_from_map;
+  StopMappingThread();  // every queued keyframe is mapped first; mapping is idle below
+  map_->Write([&](MapData& data) { ApplyWorldAlignment(world_from_map, &data); });
+  tracker_->ApplySimilarity(world_from_map);
+  const auto to_world = [&](const Rigid3& cam_from_map) {
+    return world_from_map.TransformPose(cam_from_map.Inverse()).Inverse();
+  };
+  for (TrackedPose& pose : poses_) {
+    // Marker-only and frozen poses (no reference) are in the world already; on a
+    // re-alignment the poses tied to this map's keyframes move with them.
+    const bool moves = !pose.in_world || (world_aligned_ && pose.reference.IsValid());
+    if (!moves) continue;
+    pose.cam_from_world = to_world(pose.cam_from_world);
+    pose.cam_from_reference.translation *= world_from_map.scale;
+    pose.in_world = true;
+  }
+  if (frame != nullptr && frame->cam_from_world) {
+    frame->cam_from_world = to_world(*frame->cam_from_world);
+  }
+  next_alignment_anchors_ = 2 * static_cast<int>(anchors.size());
+  mapping_busy_ = false;
+  StartMappingThread();
+  ARUCOSLAM_LOG_DEBUG("keypoint map {}aligned to the marker world: scale {:.4f}, {} of {} "
+                      "anchors, rms {:.3f} m",
+                      world_aligned_ ? "re-" : "", world_from_map.scale, alignment.num_inliers,
+                      anchors.size(), alignment.rms_m);
+  world_aligned_ = true;
+  std::lock_guard lock(stats_mutex_);
+  ++stats_.num_world_alignments;
+}
+
+void System::RecordMarkerPose(const Frame& frame, FrameReport& report) {
+  const Rigid3 cam_from_world = fix_->world_from_cam.Inverse();
+  report.cam_from_world = cam_from_world;
+  report.marker_pose = true;
+  TrackedPose pose;
+  pose.timestamp_s = frame.timestamp_s;
+  pose.cam_from_reference = cam_from_world;
+  pose.cam_from_world = cam_from_world;
+  pose.in_world = true;
+  poses_.push_back(pose);
+  std::lock_guard lock(stats_mutex_);
+  ++stats_.num_marker_only_poses;
+}
+
+}  // namespace arucoslam
