@@ -21,23 +21,8 @@ struct FuseAction {
 void ProjectAndMatch(const MapData& data, const Keyframe& target,
                      const std::vector<MapPointId>& points, const LocalMapperOptions& options,
                      std::vector<FuseAction>* actions) {
-  const Rigid3& cam_from_world = target.cam_from_world;
-  const Eigen::Vector3d centre = target.CameraCenter();
-  ProjectionQueries set;
-  for (const MapPointId& id : points) {
-    const MapPoint* point = data.FindMapPoint(id);
-    if (point == nullptr || point->observations.count(target.id) != 0) continue;
-    const Eigen::Vector3d p_in_cam = cam_from_world * point->p_in_world;
-    if (!(p_in_cam.z() > 0.0)) continue;
-    const std::optional<Eigen::Vector2d> pixel = target.camera.Project(p_in_cam);
-    if (!pixel || !target.camera.InImage(*pixel)) continue;
-    const Eigen::Vector3d ray = point->p_in_world - centre;
-    const double distance = ray.norm();
-    if (!point->InDistanceRange(distance) || point->normal.dot(ray) < 0.5 * distance) continue;
-    set.Add(id, *pixel, point->PredictLevel(distance, target.features.pyramid), point->descriptor,
-            1.0, -1.0f);
-  }
-  set.Finalize();
+  const ProjectionQueries set = UnobservedPointQueries(data, target, target.cam_from_world,
+                                                        target.CameraCenter(), points);
   if (set.queries.empty()) return;
   ProjectionMatchOptions match_options;
   match_options.base_radius_px = options.fusion_radius_px;

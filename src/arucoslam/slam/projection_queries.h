@@ -6,6 +6,7 @@
 
 #include "arucoslam/feature/orb_matcher.h"
 #include "arucoslam/map/frame.h"
+#include "arucoslam/map/map_data.h"
 #include "arucoslam/map/map_point.h"
 
 namespace arucoslam {
@@ -37,5 +38,32 @@ struct ProjectionQueries {
     return assigned;
   }
 };
+
+// Queries for the points of `point_ids` that `target` does not observe yet, projected with
+// `cam_from_world` (a Rigid3, or a Sim3 for loop-corrected poses) from `camera_centre`: kept
+// when in front, inside the image, within the point's distance range and seen within 60
+// degrees of its normal. Angles are unknown (-1: no rotation check). Finalized on return.
+template <typename Transform>
+ProjectionQueries UnobservedPointQueries(const MapData& data, const Keyframe& target,
+                                         const Transform& cam_from_world,
+                                         const Eigen::Vector3d& camera_centre,
+                                         const std::vector<MapPointId>& point_ids) {
+  ProjectionQueries set;
+  for (const MapPointId& id : point_ids) {
+    const MapPoint* point = data.FindMapPoint(id);
+    if (point == nullptr || point->observations.count(target.id) != 0) continue;
+    const Eigen::Vector3d p_in_cam = cam_from_world * point->p_in_world;
+    if (!(p_in_cam.z() > 0.0)) continue;
+    const std::optional<Eigen::Vector2d> pixel = target.camera.Project(p_in_cam);
+    if (!pixel || !target.camera.InImage(*pixel)) continue;
+    const Eigen::Vector3d ray = point->p_in_world - camera_centre;
+    const double distance = ray.norm();
+    if (!point->InDistanceRange(distance) || point->normal.dot(ray) < 0.5 * distance) continue;
+    set.Add(id, *pixel, point->PredictLevel(distance, target.features.pyramid), point->descriptor,
+            1.0, -1.0f);
+  }
+  set.Finalize();
+  return set;
+}
 
 }  // namespace arucoslam
