@@ -248,11 +248,7 @@ MarkerBundleAdjustmentSummary SolveMarkerBundleAdjustment(
   ceres::Solver::Summary ceres_summary;
   ceres::Solve(solver_options, &ceres_problem, &ceres_summary);
 
-  summary.success = ceres_summary.IsSolutionUsable();
-  summary.num_iterations = static_cast<int>(ceres_summary.iterations.size()) - 1;
-  summary.initial_cost = ceres_summary.initial_cost;
-  summary.final_cost = ceres_summary.final_cost;
-  summary.message = ceres_summary.message;
+  ceres_internal::CopySolverSummary(ceres_summary, &summary);
   if (summary.success) blocks.CopyTo(problem);
   summary.final_keypoint_rms_px = ReprojectionRmsPixels(problem->keypoints);
   summary.final_marker_rms_px = MarkerReprojectionRmsPixels(*problem);

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "arucoslam/optim/pose_graph.h"
+#include "arucoslam/optim/se3_manifold_ceres.h"
 #include "arucoslam/optim/pose_graph_residuals.h"
 #include "arucoslam/util/timing.h"
 
@@ -158,11 +159,7 @@ PoseGraphSummary SolvePoseGraph(const PoseGraphOptions& options, PoseGraphProble
   ceres::Solver::Summary ceres_summary;
   ceres::Solve(solver_options, &ceres_problem, &ceres_summary);
 
-  summary.success = ceres_summary.IsSolutionUsable();
-  summary.num_iterations = static_cast<int>(ceres_summary.iterations.size()) - 1;
-  summary.initial_cost = ceres_summary.initial_cost;
-  summary.final_cost = ceres_summary.final_cost;
-  summary.message = ceres_summary.message;
+  ceres_internal::CopySolverSummary(ceres_summary, &summary);
   if (summary.success) {
     for (std::size_t n = 0; n < blocks.size(); ++n) {
       if (!blocks[n].used || problem->nodes[n].fixed) continue;

@@ -1,5 +1,5 @@
-// Internal to optim/'s *_ceres.cc files: a pose stored as a Ceres block [qx qy qz qw tx ty tz]
-// and the left-multiplicative SE(3) manifold on it. Not for headers outside *_ceres.cc.
+// Internal to optim/'s *_ceres.cc files: a pose stored as a Ceres block [qx qy qz qw tx ty tz],
+// the left-multiplicative SE(3) manifold on it, and the solver-summary copy they share.
 #pragma once
 
 #include <ceres/ceres.h>
@@ -60,5 +60,16 @@ class Se3LeftManifold : public ceres::Manifold {
     return true;
   }
 };
+
+// Copies what every optim/ summary reports of a Ceres solve (success, iterations, costs,
+// message) into `summary`, whose type has those fields.
+template <typename Summary>
+void CopySolverSummary(const ceres::Solver::Summary& ceres_summary, Summary* summary) {
+  summary->success = ceres_summary.IsSolutionUsable();
+  summary->num_iterations = static_cast<int>(ceres_summary.iterations.size()) - 1;
+  summary->initial_cost = ceres_summary.initial_cost;
+  summary->final_cost = ceres_summary.final_cost;
+  summary->message = ceres_summary.message;
+}
 
 }  // namespace arucoslam::ceres_internal
