@@ -1,16 +1,20 @@
 // `arucoslam run`: monocular SLAM over a sequence (EuRoC layout, TUM RGB-D folder or image
-// folder) -> trajectory.tum, keyframes.tum, map.ply and stats.json in one output folder.
+// folder) -> trajectory.tum, keyframes.tum, map.ply and stats.json in one output folder;
+// map reuse: --save-map writes the map file after the run, --load-map starts from one,
+// --localize-only tracks against it without changing it.
 #include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "arucoslam/exe/command.h"
 #include "arucoslam/exe/slam_run.h"
 #include "arucoslam/io/dataset_reader.h"
 #include "arucoslam/io/marker_map_json.h"
 #include "arucoslam/util/error.h"
+#include "arucoslam/util/files.h"
 
 namespace arucoslam {
 namespace {
@@ -24,13 +28,33 @@ struct RunArgs {
   bool quiet = false;
   int num_features = 1000;
   double rate_hz = 0.0;
+  std::string save_map;
+  std::string load_map;
+  bool localize_only = false;
 };
+
+void CheckMapArgs(const RunArgs& args) {
+  if (args.localize_only && args.load_map.empty()) {
+    throw InputError("--localize-only", "needs --load-map FILE (the map to localise in)");
+  }
+  if (args.localize_only && !args.save_map.empty()) {
+    throw InputError("--save-map", "not with --localize-only (the loaded map is not changed)");
+  }
+  if (!args.save_map.empty()) {
+    const std::filesystem::path folder = std::filesystem::path(args.save_map).parent_path();
+    if (!folder.empty()) RequireDirectory(folder, "folder for --save-map");
+    if (std::filesystem::is_directory(args.save_map)) {
+      throw InputError(args.save_map, "--save-map names a folder, expected a file");
+    }
+  }
+}
 
 int RunSlam(const RunArgs& args) {
   if (args.num_features < 100) {
     throw InputError("--features", "expected at least 100, got " + std::to_string(args.num_features));
   }
   if (args.rate_hz < 0.0) throw InputError("--rate", "expected a rate >= 0 Hz");
+  CheckMapArgs(args);
   DatasetOptions dataset_options;
   dataset_options.camera_path = args.camera;
   dataset_options.rate_hz = args.rate_hz;
@@ -47,9 +71,17 @@ int RunSlam(const RunArgs& args) {
     options.detector.dictionary = options.marker_map->dictionary;
   }
   const bool markers = options.marker_map.has_value();
-  const SlamRunResult result =
-      RunSlamOnDataset(dataset, args.dataset, options, markers, args.out, !args.quiet);
+  MapReuse reuse;
+  if (!args.load_map.empty()) LoadMapForRun(args.load_map, dataset.camera(), reuse);
+  reuse.localize_only = args.localize_only;
+  reuse.save = args.save_map;
+  const SlamRunResult result = RunSlamOnDataset(dataset, args.dataset, options, markers,
+                                                args.out, !args.quiet, std::move(reuse));
   std::printf("%s\n", SlamRunSummary(result, args.out).c_str());
+  if (!args.save_map.empty()) {
+    std::printf("map saved to %s (%d keyframes, %d points)\n", args.save_map.c_str(),
+                result.stats.keyframes, result.stats.map_points);
+  }
   return kExitOk;
 }
 
@@ -78,6 +110,14 @@ void AddRunCommand(CLI::App& app, int& exit_status) {
       ->capture_default_str();
   run->add_option("--rate", args->rate_hz, "image folder frame rate in Hz (0: from the camera)")
       ->capture_default_str();
+  run->add_option("--save-map", args->save_map,
+                  "write the map to this file after the run (binary, versioned)");
+  run->add_option("--load-map", args->load_map,
+                  "start from this map file instead of an empty map: frames get poses once "
+                  "relocalised in it (markers or keyframe matches), no new map is started");
+  run->add_flag("--localize-only", args->localize_only,
+                "with --load-map: track against the loaded map without adding keyframes or "
+                "points");
   run->callback([args, &exit_status] { exit_status = RunSlam(*args); });
 }
 

@@ -2,8 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
 #include <cstdio>
+#include <utility>
 
+#include "arucoslam/util/error.h"
 #include "arucoslam/util/files.h"
 #include "arucoslam/util/timing.h"
 
@@ -45,12 +48,34 @@ SlamRunStats MakeStats(const std::string& dataset_label, const Dataset& dataset,
 
 }  // namespace
 
+void LoadMapForRun(const std::filesystem::path& path, const CameraModel& camera,
+                   MapReuse& reuse) {
+  MapData map = LoadMapFile(path, &reuse.loaded_info);
+  if (map.NumKeyframes() == 0) throw InputError(path.string(), "the map has no keyframes");
+  const CameraModel& mapped = map.keyframes().begin()->second.camera;
+  if (mapped.width != camera.width || mapped.height != camera.height ||
+      std::abs(mapped.fx - camera.fx) > 1e-6 * camera.fx ||
+      std::abs(mapped.fy - camera.fy) > 1e-6 * camera.fy) {
+    throw InputError(path.string(),
+                     fmt::format("map made with a {}x{} camera (fx {:.1f}), the sequence's is "
+                                 "{}x{} (fx {:.1f})",
+                                 mapped.width, mapped.height, mapped.fx, camera.width,
+                                 camera.height, camera.fx));
+  }
+  reuse.loaded = std::move(map);
+}
+
 SlamRunResult RunSlamOnDataset(const Dataset& dataset, const std::string& dataset_label,
                                const SystemOptions& options, bool markers,
-                               const std::filesystem::path& out_dir, bool progress) {
+                               const std::filesystem::path& out_dir, bool progress,
+                               MapReuse reuse) {
   StagedDirectory staged(out_dir);
   const Stopwatch wall;
   System system(dataset.camera(), options);
+  if (reuse.loaded) {
+    system.StartFromMap(std::move(*reuse.loaded), reuse.loaded_info.world_aligned,
+                        reuse.localize_only);
+  }
   for (std::size_t i = 0; i < dataset.size(); ++i) {
     const FrameReport report =
         system.ProcessImage(dataset.LoadImage(i), dataset.frame(i).timestamp_s);
@@ -71,6 +96,11 @@ SlamRunResult RunSlamOnDataset(const Dataset& dataset, const std::string& datase
   result.timing = system.Stats();
   WriteSlamOutput(staged.path(), result.trajectory, result.keyframes, system.MapPoints(),
                   result.stats);
+  if (!reuse.save.empty()) {
+    MapFileInfo info;
+    info.world_aligned = system.world_aligned();
+    SaveMapFile(system.map(), reuse.save, info);
+  }
   staged.Commit();
   return result;
 }
@@ -84,7 +114,9 @@ std::string SlamRunSummary(const SlamRunResult& result, const std::string& out_d
       stats.frames > 0 ? 100.0 * stats.frames_tracked / stats.frames : 0.0, stats.losses,
       stats.keyframes, stats.map_points, result.timing.tracking_ms.Summarize().median,
       result.timing.local_mapping_ms.Summarize().median, stats.wall_time_s, out_dir);
-  if (stats.initializations == 0) line += "\nmap not initialised (no camera motion found)";
+  if (stats.initializations == 0 && stats.keyframes == 0) {
+    line += "\nmap not initialised (no camera motion found)";
+  }
   return line;
 }
 

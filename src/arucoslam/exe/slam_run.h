@@ -1,17 +1,33 @@
 // RunSlamOnDataset: one SLAM run over a whole sequence, shared by `run` and `experiments`:
 // feeds every image to the System, then writes trajectory.tum, keyframes.tum, map.ply and
-// stats.json into an output folder (all-or-nothing).
+// stats.json into an output folder (all-or-nothing); optionally starts from a saved map and
+// saves the map after the run.
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "arucoslam/io/dataset_reader.h"
+#include "arucoslam/io/map_file.h"
 #include "arucoslam/io/slam_output.h"
 #include "arucoslam/io/trajectory_io.h"
 #include "arucoslam/pipeline/system.h"
 
 namespace arucoslam {
+
+// Map reuse for one run (`run --load-map/--save-map/--localize-only`).
+struct MapReuse {
+  std::optional<MapData> loaded;  // start from this map (LoadMapForRun)
+  MapFileInfo loaded_info;
+  bool localize_only = false;     // track against `loaded` without changing it
+  std::filesystem::path save;     // empty: the map is not saved
+};
+
+// Reads a map file for a run on `camera`'s images; InputError naming the file when it is
+// missing, bad, empty or made with another camera.
+void LoadMapForRun(const std::filesystem::path& path, const CameraModel& camera,
+                   MapReuse& reuse);
 
 struct SlamRunResult {
   Trajectory trajectory;  // every frame with a pose, world_from_cam
@@ -24,7 +40,8 @@ struct SlamRunResult {
 // sequence's marker map. A progress line goes to stderr when `progress` is set.
 SlamRunResult RunSlamOnDataset(const Dataset& dataset, const std::string& dataset_label,
                                const SystemOptions& options, bool markers,
-                               const std::filesystem::path& out_dir, bool progress);
+                               const std::filesystem::path& out_dir, bool progress,
+                               MapReuse reuse = {});
 
 // One summary line of a finished run.
 std::string SlamRunSummary(const SlamRunResult& result, const std::string& out_dir);

@@ -363,11 +363,14 @@ MapPoint GetMapPoint(ByteReader& in) {
 }
 
 // What the payload holds, before it is rebuilt into a MapData.
+constexpr std::uint32_t kWorldAlignedFlag = 1;
+
 struct StoredMap {
   KeyframeId first_keyframe;
   std::vector<Keyframe> keyframes;  // increasing ids
   std::vector<MapPoint> points;     // increasing ids, observations as stored
   std::map<KeyframeId, KeyframeId> parent_of;
+  MapFileInfo info;
 };
 
 template <typename Id>
@@ -380,6 +383,12 @@ void RequireIncreasing(const ByteReader& in, Id previous, Id id, std::string_vie
 
 StoredMap ParsePayload(ByteReader& in) {
   StoredMap stored;
+  in.ExpectTag("META");
+  const auto flags = in.Get<std::uint32_t>("map flags");
+  if ((flags & ~kWorldAlignedFlag) != 0) {
+    throw in.Corrupt(fmt::format("unknown map flags {:#x}", flags));
+  }
+  stored.info.world_aligned = (flags & kWorldAlignedFlag) != 0;
   in.ExpectTag("CAMS");
   std::vector<CameraModel> cameras(in.GetCount(89, "cameras"));
   for (CameraModel& camera : cameras) camera = GetCamera(in);
@@ -560,13 +569,15 @@ std::uint64_t Fnv1a64(std::string_view bytes) {
   return hash;
 }
 
-std::string SerializeMap(const MapData& data) {
+std::string SerializeMap(const MapData& data, const MapFileInfo& info) {
   const auto [cameras, camera_indices] = CameraTable(data);
   ByteWriter out;
   out.PutTag(kMagic);
   out.Put(kByteOrderMarker);
   out.Put(kMapFormatVersion);
   out.Put<std::uint64_t>(0);  // payload size, patched below
+  out.PutTag("META");
+  out.Put<std::uint32_t>(info.world_aligned ? kWorldAlignedFlag : 0);
   out.PutTag("CAMS");
   out.PutCount(cameras.size());
   for (const std::string& camera : cameras) out.PutBytes(camera.data(), camera.size());
@@ -600,7 +611,7 @@ std::string SerializeMap(const MapData& data) {
   return std::move(bytes);
 }
 
-MapData DeserializeMap(std::string_view bytes, const std::string& source) {
+MapData DeserializeMap(std::string_view bytes, const std::string& source, MapFileInfo* info) {
   const std::string_view payload = CheckEnvelope(bytes, source);
   ByteReader reader(payload, source, kHeaderBytes);
   StoredMap stored = ParsePayload(reader);
@@ -609,25 +620,28 @@ MapData DeserializeMap(std::string_view bytes, const std::string& source) {
   RestoreSpanningTree(stored, data, source);
   const std::string violation = data.CheckInvariants();
   if (!violation.empty()) throw InputError(source, "inconsistent map file: " + violation);
+  if (info != nullptr) *info = stored.info;
   return data;
 }
 
-void SaveMapFile(const MapData& data, const std::filesystem::path& path) {
-  WriteTextFileAtomically(path, SerializeMap(data));
+void SaveMapFile(const MapData& data, const std::filesystem::path& path,
+                 const MapFileInfo& info) {
+  WriteTextFileAtomically(path, SerializeMap(data, info));
 }
 
-void SaveMapFile(const Map& map, const std::filesystem::path& path) {
-  const std::string bytes = map.Read([](const MapData& data) { return SerializeMap(data); });
+void SaveMapFile(const Map& map, const std::filesystem::path& path, const MapFileInfo& info) {
+  const std::string bytes =
+      map.Read([&info](const MapData& data) { return SerializeMap(data, info); });
   WriteTextFileAtomically(path, bytes);
 }
 
-MapData LoadMapFile(const std::filesystem::path& path) {
+MapData LoadMapFile(const std::filesystem::path& path, MapFileInfo* info) {
   RequireFile(path, "map file");
-  return DeserializeMap(ReadTextFile(path), path.string());
+  return DeserializeMap(ReadTextFile(path), path.string(), info);
 }
 
-void LoadMapFile(const std::filesystem::path& path, Map& map) {
-  MapData loaded = LoadMapFile(path);
+void LoadMapFile(const std::filesystem::path& path, Map& map, MapFileInfo* info) {
+  MapData loaded = LoadMapFile(path, info);
   map.Write([&loaded](MapData& data) { data = std::move(loaded); });
 }
 

@@ -12,11 +12,12 @@
 
 namespace arucoslam {
 
-// Layout of format version 1 (all numbers little-endian, doubles as IEEE-754 bit patterns,
+// Layout of format version 2 (all numbers little-endian, doubles as IEEE-754 bit patterns,
 // so poses and positions load back bit-exact):
 //   header  : 16 magic bytes "ARUCOSLAM-MAP\r\n\x1a", u32 endianness marker 0x01020304,
 //             u32 format version, u64 payload size in bytes;
-//   payload : sections "CAMS" (distinct cameras), "KFRM" (keyframes: ids, timestamp, pose,
+//   payload : sections "META" (u32 flags: bit 0 = the map is in the marker world frame with
+//             metric scale), "CAMS" (distinct cameras), "KFRM" (keyframes: ids, timestamp, pose,
 //             camera index, keypoints with octave/angle/response, descriptors, undistorted
 //             coordinates, pyramid tables, image size, map point id per keypoint, markers),
 //             "MPTS" (points: id, position, descriptor, observations, reference keyframe,
@@ -25,30 +26,40 @@ namespace arucoslam {
 // Covisibility weights are not stored: by definition they count the points two keyframes
 // share, so loading rebuilds them exactly from the observations. The spanning tree depends
 // on the map's history and is stored. Ids are kept; the loaded map hands out new ids above
-// the largest loaded one.
-inline constexpr std::uint32_t kMapFormatVersion = 1;
+// the largest loaded one. Version 1 (no "META") is refused like any other version.
+inline constexpr std::uint32_t kMapFormatVersion = 2;
+
+// What a map file records about its map beyond keyframes and points.
+struct MapFileInfo {
+  // The map is in the marker world frame (metric): marker poses relocalise into it.
+  bool world_aligned = false;
+};
 
 // The bytes of a map file for `data`. Throws std::invalid_argument for descriptors that are
 // not 32-byte CV_8U rows.
-std::string SerializeMap(const MapData& data);
+std::string SerializeMap(const MapData& data, const MapFileInfo& info = {});
 
 // Decodes the bytes of a map file; `source` names them in errors. Throws InputError(source,
 // ...) for: wrong magic ("not an arucoslam map"), another format version, a truncated file
 // ("ends after N bytes, expected M"), trailing bytes, a checksum mismatch, or content that is
-// inconsistent (unknown ids, broken spanning tree, observations not mirrored).
-MapData DeserializeMap(std::string_view bytes, const std::string& source);
+// inconsistent (unknown ids, broken spanning tree, observations not mirrored). `info`, when
+// given, receives the file's MapFileInfo.
+MapData DeserializeMap(std::string_view bytes, const std::string& source,
+                       MapFileInfo* info = nullptr);
 
 // Writes the map file atomically (temporary file + rename). Throws InputError naming `path`
 // when the folder is not writable.
-void SaveMapFile(const MapData& data, const std::filesystem::path& path);
+void SaveMapFile(const MapData& data, const std::filesystem::path& path,
+                 const MapFileInfo& info = {});
 // Same for a shared Map: serialises under one read lock, writes after releasing it.
-void SaveMapFile(const Map& map, const std::filesystem::path& path);
+void SaveMapFile(const Map& map, const std::filesystem::path& path,
+                 const MapFileInfo& info = {});
 
 // Reads a map file; throws InputError naming `path` when it is missing or bad (see above).
-MapData LoadMapFile(const std::filesystem::path& path);
+MapData LoadMapFile(const std::filesystem::path& path, MapFileInfo* info = nullptr);
 // Replaces the content of `map` with the file's map (all or nothing: `map` is untouched
 // when loading throws).
-void LoadMapFile(const std::filesystem::path& path, Map& map);
+void LoadMapFile(const std::filesystem::path& path, Map& map, MapFileInfo* info = nullptr);
 
 // FNV-1a, 64 bit, of `bytes` (the trailer of a map file).
 std::uint64_t Fnv1a64(std::string_view bytes);

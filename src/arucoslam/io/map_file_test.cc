@@ -321,8 +321,31 @@ TEST(MapFileTest, WrongMagicIsNotAMap) {
 
 TEST(MapFileTest, OtherVersionIsNamed) {
   std::string bytes = SerializeMap(BuildTestMap(3, 20, 30, 5));
-  bytes[20] = 3;  // version field (u32 little-endian after magic and byte-order marker)
-  EXPECT_EQ(ErrorOf(bytes), "map format version 3, this build reads 1");
+  ASSERT_EQ(bytes[20], 2);  // version field (u32 little-endian after magic and byte order)
+  bytes[20] = 3;
+  EXPECT_EQ(ErrorOf(bytes), "map format version 3, this build reads 2");
+  // A file of the previous version (no world-alignment flags) is refused the same way.
+  bytes[20] = 1;
+  EXPECT_EQ(ErrorOf(bytes), "map format version 1, this build reads 2");
+}
+
+TEST(MapFileTest, WorldAlignmentFlagRoundTrips) {
+  const MapData original = BuildTestMap(3, 20, 30, 10);
+  for (const bool aligned : {false, true}) {
+    MapFileInfo written;
+    written.world_aligned = aligned;
+    const std::string bytes = SerializeMap(original, written);
+    MapFileInfo read;
+    read.world_aligned = !aligned;
+    ExpectMapsEqual(original, DeserializeMap(bytes, "test.map", &read));
+    EXPECT_EQ(read.world_aligned, aligned);
+  }
+  // Unknown flag bits are corruption, not silently ignored.
+  std::string bytes = SerializeMap(original);
+  ASSERT_EQ(bytes.substr(32, 4), "META");
+  bytes[36] = 4;
+  EXPECT_NE(ErrorOf(Resign(bytes)).find("unknown map flags 0x4"), std::string::npos)
+      << ErrorOf(Resign(bytes));
 }
 
 TEST(MapFileTest, TruncationAtAnyOffsetIsDetected) {

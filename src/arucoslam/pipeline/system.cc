@@ -112,11 +112,13 @@ FrameReport System::ProcessFrame(Frame frame, const std::vector<MarkerDetection>
   if (frame.map_point_ids.size() != frame.features.size()) frame.ResetMatches();
   fix_ = LocateWithMarkers(frame, detections, report);
   if (tracker_->state() == TrackingState::kNotInitialized) {
-    Initialize(frame, report);
+    map_loaded_ ? LocalizeInLoadedMap(frame, report) : Initialize(frame, report);
   } else {
     Track(frame, report);
   }
-  if (!report.cam_from_world && fix_) RecordMarkerPose(frame, report);
+  // A loaded map that stays outside the marker world takes no marker-only poses.
+  const bool marker_poses = world_aligned_ || !localize_only_;
+  if (!report.cam_from_world && fix_ && marker_poses) RecordMarkerPose(frame, report);
   report.world_aligned = world_aligned_;
   {
     std::lock_guard lock(stats_mutex_);
@@ -201,7 +203,8 @@ void System::Initialize(Frame& frame, FrameReport& report) {
 void System::Track(Frame& frame, FrameReport& report) {
   static const std::vector<MarkerPoseObservation> kNoMarkers;
   TrackingResult result = tracker_->Track(frame, world_aligned_ && fix_ ? fix_->markers : kNoMarkers);
-  if (result.state != TrackingState::kTracking && RelocalizeWithMarkers(frame, report)) {
+  if (result.state != TrackingState::kTracking &&
+      (RelocalizeWithMarkers(frame, report) || RelocalizeInLoadedMap(frame, report))) {
     result.state = TrackingState::kTracking;
     result.num_inliers = report.num_inliers;
   }
@@ -220,7 +223,7 @@ void System::Track(Frame& frame, FrameReport& report) {
     // keep coming and it does not take them back.
     const bool stuck = fix_ && ++lost_with_markers_ >= options_.marker_reset_lost_frames;
     const bool young = static_cast<int>(map_->NumKeyframes()) <= options_.reset_max_keyframes;
-    if (stuck || (young && !world_aligned_)) {
+    if (!map_loaded_ && (stuck || (young && !world_aligned_))) {
       ResetMap();
     }
     return;
@@ -234,6 +237,7 @@ void System::Track(Frame& frame, FrameReport& report) {
 }
 
 void System::MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& report) {
+  if (localize_only_) return;
   KeyframeDecisionInput input;
   input.frames_since_last_keyframe = frames_since_keyframe_;
   input.num_tracked = num_inliers;

@@ -113,6 +113,7 @@ struct SystemStats {
   int num_marker_only_poses = 0;  // frames whose pose came from markers alone
   int num_world_alignments = 0;
   int num_marker_relocalizations = 0;  // tracking restarted from a marker pose
+  int num_map_relocalizations = 0;     // loaded map: restarted from a keyframe match
 };
 
 struct StampedPose {
@@ -133,6 +134,13 @@ class System {
   FrameReport ProcessFrame(Frame frame);
   // The same with the image's marker detections (distorted pixels), used with a marker map.
   FrameReport ProcessFrame(Frame frame, const std::vector<MarkerDetection>& detections);
+  // Map reuse (system_map_reuse.cc): before the first frame, replaces the empty map with a
+  // saved one (`world_aligned`: in the marker world frame). No map is initialised over it:
+  // frames get no pose until a relocalisation into it succeeds (from markers when aligned,
+  // else from keyframe matches). `localize_only`: no keyframe, no mapping, no alignment and
+  // no reset; the map's keyframes and points stay as loaded.
+  void StartFromMap(MapData map, bool world_aligned, bool localize_only);
+  bool localize_only() const { return localize_only_; }
   // Waits until every queued keyframe is mapped and stops the mapping thread. Called by
   // the destructor; ProcessImage may not be called after it.
   void Finish();
@@ -172,6 +180,12 @@ class System {
                                              const std::vector<MarkerDetection>& detections,
                                              FrameReport& report);
   bool RelocalizeWithMarkers(Frame& frame, FrameReport& report);
+  // Map reuse (system_map_reuse.cc): a frame before the first localisation in a loaded map,
+  // and the keyframe-seeded relocalisation (brute-force matching against a few keyframes
+  // per frame, pose-only optimisation, then TrackFromPose).
+  void LocalizeInLoadedMap(Frame& frame, FrameReport& report);
+  bool RelocalizeInLoadedMap(Frame& frame, FrameReport& report);
+  std::optional<Rigid3> SeedPoseFromKeyframes(const Frame& frame);
   void AddAnchor(KeyframeId keyframe, const std::optional<MarkerFix>& fix);
   // Aligns the map to the world once enough anchors exist; `frame` (the current one, its
   // pose in the map) is carried along.
@@ -207,6 +221,10 @@ class System {
   int next_alignment_anchors_ = 0;  // alignment is tried again at this many anchors
   int lost_with_markers_ = 0;
   double detection_ms_ = 0.0;  // marker detection time of the current image
+
+  bool map_loaded_ = false;    // started from a saved map (StartFromMap)
+  bool localize_only_ = false;
+  std::size_t next_seed_keyframe_ = 0;  // round-robin position of SeedPoseFromKeyframes
 
   std::unique_ptr<BoundedQueue<KeyframeId>> queue_;
   std::thread mapping_thread_;
