@@ -128,6 +128,7 @@ TEST_F(RunMapReuseTest, SavedMapLocalisesASequenceStartingElsewhere) {
   const std::string stats = ReadTextFile(dir_ / "run_b" / "stats.json");
   EXPECT_NE(stats.find("\"keyframes_inserted\": 0"), std::string::npos) << stats;
   EXPECT_NE(stats.find("\"initializations\": 0"), std::string::npos) << stats;
+  EXPECT_EQ(stats.find("\"relocalisations\": 0"), std::string::npos) << stats;
   EXPECT_NE(stats.find("\"points\": " + std::to_string(saved.NumMapPoints())), std::string::npos)
       << stats;
 }

@@ -31,6 +31,7 @@ SlamRunStats MakeStats(const std::string& dataset_label, const Dataset& dataset,
   out.frames_tracked = stats.num_tracked;
   out.frames_lost = stats.num_lost;
   out.losses = stats.num_losses;
+  out.relocalisations = stats.num_marker_relocalizations + stats.num_map_relocalizations;
   out.initialization_attempts = stats.num_initialization_attempts;
   out.initializations = stats.num_initializations;
   out.resets = stats.num_resets;
