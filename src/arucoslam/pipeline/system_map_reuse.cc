@@ -18,8 +18,9 @@ namespace {
 // N keyframes is searched in N / 8 frames): brute-force matching against one keyframe takes
 // about 10 ms (measured on a loaded machine: 150-200 ms per frame for 15 keyframes).
 constexpr std::size_t kSeedKeyframesPerFrame = 8;
-// Descriptor matches to map points needed before a keyframe's pose is refined.
-constexpr int kMinSeedMatches = 30;
+// Descriptor matches to map points that must remain inliers of the refined seed pose (as
+// many as the tracker wants after its local-map search).
+constexpr int kMinSeedInliers = 30;
 
 }  // namespace
 
@@ -57,8 +58,10 @@ bool System::RelocalizeInLoadedMap(Frame& frame, FrameReport& report) {
   if (result.state != TrackingState::kTracking) return false;
   report.num_inliers = result.num_inliers;
   report.message = "relocalised in the loaded map";
-  ARUCOSLAM_LOG_DEBUG("frame {}: relocalised in the loaded map, {} inliers", report.index,
-                      result.num_inliers);
+  ARUCOSLAM_LOG_DEBUG(
+      "frame {}: relocalised in the loaded map, {} inliers, {:.2f} m from the seed pose",
+      report.index, result.num_inliers,
+      (frame.cam_from_world->Inverse().translation - seed->Inverse().translation).norm());
   std::lock_guard lock(stats_mutex_);
   ++stats_.num_map_relocalizations;
   return true;
@@ -98,12 +101,14 @@ std::optional<Rigid3> System::SeedPoseFromKeyframes(const Frame& frame) {
     });
   }
   next_seed_keyframe_ = (next_seed_keyframe_ + count) % keyframes.size();
-  if (static_cast<int>(best.size()) < kMinSeedMatches) return std::nullopt;
+  if (static_cast<int>(best.size()) < kMinSeedInliers) return std::nullopt;
   PoseOptimizationOptions pose_options = options_.tracker.pose;
   pose_options.min_inliers = options_.tracker.min_pose_inliers;
   const PoseOptimizationResult refined = OptimizePose(
       best, best_pose, PinholeIntrinsics::FromCamera(frame.camera), pose_options);
-  if (!refined.success) return std::nullopt;
+  ARUCOSLAM_LOG_DEBUG("seed: {} matches, {} inliers, rms {:.2f} px", best.size(),
+                      refined.num_inliers, refined.final_rms_px);
+  if (!refined.success || refined.num_inliers < kMinSeedInliers) return std::nullopt;
   return refined.cam_from_world;
 }
 
