@@ -79,9 +79,11 @@ struct Pass {
 
 // Feeds the frames at `route` positions (timestamps kDt apart) to a System, optionally
 // started from `loaded`. The scene (points and descriptors) is the same for every pass.
+// Frames [blackout_begin, blackout_end) have neither keypoints nor markers.
 Pass RunPass(const std::vector<double>& route, bool markers, bool blocking,
              const MapData* loaded = nullptr, bool loaded_aligned = false,
-             bool localize_only = false, std::uint32_t noise_seed = 1) {
+             bool localize_only = false, std::uint32_t noise_seed = 1,
+             std::size_t blackout_begin = 0, std::size_t blackout_end = 0) {
   SyntheticFeatureScene scene(TestCamera());
   SystemOptions options;
   options.blocking = blocking;
@@ -95,8 +97,13 @@ Pass RunPass(const std::vector<double>& route, bool markers, bool blocking,
   for (std::size_t i = 0; i < route.size(); ++i) {
     const Rigid3 cam_from_world = WorldFromCam(route[i]).Inverse();
     Frame frame = scene.MakeFrame(FrameId(i), kDt * i, cam_from_world, &truth);
-    const std::vector<MarkerDetection> detections =
+    std::vector<MarkerDetection> detections =
         markers ? Detect(*options.marker_map, cam_from_world, rng) : std::vector<MarkerDetection>{};
+    if (i >= blackout_begin && i < blackout_end) {
+      frame.features = OrbFeatures();
+      frame.ResetMatches();
+      detections.clear();
+    }
     pass.reports.push_back(system.ProcessFrame(std::move(frame), detections));
   }
   system.Finish();
@@ -210,6 +217,26 @@ TEST(SystemMapReuse, KeypointMapLocalisesASecondPassFromKeyframeMatches) {
   // pass too (measured 1.5 mm RMS; bound 1% of the 2.4 m route, as for a single pass).
   EXPECT_LT(RmsError(second, truth_from_map), 0.024);
   EXPECT_EQ(second.stats.num_keyframes_inserted, 0);
+  ExpectSameGeometry(first.map, second.map);
+}
+
+TEST(SystemMapReuse, LocaliseOnlyRelocalisesAfterABlackout) {
+  const Pass first = RunPass(Route(0, 80, 1), false, true);
+  const Sim3 truth_from_map = TruthFromMap(first);
+  // Frames 15-24 of the second pass are black: tracking is lost, then must come back.
+  const Pass second =
+      RunPass(Route(60, 20, -1), false, true, &first.map, false, true, 2, 15, 25);
+  EXPECT_GE(second.stats.num_losses, 1);
+  // The first frame is localised from keyframe matches; after the blackout the tracker's
+  // reference-keyframe search (or a relocalisation) takes the map back at once.
+  EXPECT_GE(second.stats.num_map_relocalizations, 1);
+  for (std::size_t i = 0; i < second.reports.size(); ++i) {
+    const bool black = i >= 15 && i < 25;
+    EXPECT_EQ(second.reports[i].cam_from_world.has_value(), !black) << i;
+  }
+  EXPECT_LT(RmsError(second, truth_from_map), 0.024);
+  EXPECT_EQ(second.stats.num_keyframes_inserted, 0);
+  EXPECT_EQ(second.stats.num_resets, 0);
   ExpectSameGeometry(first.map, second.map);
 }
 
