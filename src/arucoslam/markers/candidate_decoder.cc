@@ -208,24 +208,12 @@ std::vector<double> InnerCells(const std::vector<double>& values, int cells) {
   return inner;
 }
 
-}  // namespace
 
-std::optional<DecodedCandidate> DecodeCandidate(const cv::Mat& gray,
-                                                std::array<cv::Point2f, 4> corners,
-                                                const cv::aruco::Dictionary& dictionary,
-                                                const CandidateDecoderOptions& options) {
-  // Clockwise on screen (y down), as OpenCV orders its candidates.
-  const cv::Point2f d1 = corners[1] - corners[0], d2 = corners[2] - corners[0];
-  if (d1.x * d2.y - d1.y * d2.x < 0) std::swap(corners[1], corners[3]);
-  const int cells = dictionary.markerSize + 2 * options.marker_border_bits;
-  const bool refined =
-      options.edge_refinement
-          ? RefineQuadEdges(gray, cells, options.edges, corners) ||
-                RefineCorners(gray, cells, options.refine_window_cells,
-                              options.max_refine_shift_cells, corners)
-          : RefineCorners(gray, cells, options.refine_window_cells, options.max_refine_shift_cells,
-                          corners);
-  if (!refined) return std::nullopt;
+// Reads and identifies the quadrilateral `corners` (refined, clockwise).
+std::optional<DecodedCandidate> DecodeRefined(const cv::Mat& gray,
+                                              std::array<cv::Point2f, 4> corners, int cells,
+                                              const cv::aruco::Dictionary& dictionary,
+                                              const CandidateDecoderOptions& options) {
   const std::vector<double> values = SampleCells(gray, corners, cells, 1, options);
   if (values.empty()) return std::nullopt;
   DecodedCandidate decoded;
@@ -239,6 +227,31 @@ std::optional<DecodedCandidate> DecodeCandidate(const cv::Mat& gray,
   std::rotate(corners.begin(), corners.begin() + (4 - rotation) % 4, corners.end());
   decoded.corners = corners;
   return decoded;
+}
+
+}  // namespace
+
+std::optional<DecodedCandidate> DecodeCandidate(const cv::Mat& gray,
+                                                std::array<cv::Point2f, 4> corners,
+                                                const cv::aruco::Dictionary& dictionary,
+                                                const CandidateDecoderOptions& options) {
+  // Clockwise on screen (y down), as OpenCV orders its candidates.
+  const cv::Point2f d1 = corners[1] - corners[0], d2 = corners[2] - corners[0];
+  if (d1.x * d2.y - d1.y * d2.x < 0) std::swap(corners[1], corners[3]);
+  const int cells = dictionary.markerSize + 2 * options.marker_border_bits;
+  // Edge-fitted corners first; when they fail or do not decode, cornerSubPix ones.
+  std::array<cv::Point2f, 4> fitted = corners;
+  if (options.edge_refinement && RefineQuadEdges(gray, cells, options.edges, fitted)) {
+    if (std::optional<DecodedCandidate> decoded =
+            DecodeRefined(gray, fitted, cells, dictionary, options)) {
+      return decoded;
+    }
+  }
+  if (!RefineCorners(gray, cells, options.refine_window_cells, options.max_refine_shift_cells,
+                     corners)) {
+    return std::nullopt;
+  }
+  return DecodeRefined(gray, corners, cells, dictionary, options);
 }
 
 }  // namespace arucoslam

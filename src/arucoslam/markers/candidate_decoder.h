@@ -25,7 +25,8 @@ struct CandidateDecoderOptions {
   // max_refine_shift_cells (its place is then unsure) is dropped.
   double refine_window_cells = 0.6;      // fraction of a cell, > 0
   double max_refine_shift_cells = 0.75;  // cells, > 0
-  // Corners from the four sides' edges (edge_refiner.h) first; cornerSubPix when that fails.
+  // Corners from the four sides' edges (edge_refiner.h) first; cornerSubPix ones when those
+  // fail or do not decode.
   bool edge_refinement = true;
   EdgeRefineOptions edges;
   // Cells compared with a threshold between the border's black and the quiet zone's white,

@@ -398,10 +398,11 @@ bool CornersMatchAsSets(const ExpectedTag& tag, const MarkerDetection& detection
 // are 10-45 px wide (2-2.5 px per cell for most, JPEG). OpenCV 4.6 at full resolution finds
 // 22 of 47 (AprilTag quads, 8 px per cell, 0.25 cell margin); upsampled 2x with 4 px per
 // cell and rescue_rejected (edge-fitted corners, quiet-zone threshold, contour candidates
-// too), 43 within 1 px. Of the other four, three are found with a corner 1.11, 1.33 and 2.65
-// px off (the last an acute corner of a tag seen edge-on) and one (12 px wide, 1.5 px per
-// cell) is missed. Six of seven real tags that the expectations lack (checked by eye) are found;
-// any other detection fails the test.
+// too), all 47 are found, 44 within 1 px; the other three have a corner 1.14, 1.33 and 2.65
+// px off (the first two on 12 and 19 px tags, the last an acute corner of a tag seen
+// edge-on; the expectations are another detector's corners, not ground truth). The eight
+// real tags that the expectations lack (checked by eye) are found too; any other detection
+// fails the test.
 TEST(MarkerDetectorRealTest, AprilTagDetectUnitCorners) {
   const std::filesystem::path dir = DataDir("apriltag_detect_unit");
   if (!std::filesystem::exists(dir)) GTEST_SKIP() << "test data folder missing: " << dir;
@@ -419,6 +420,7 @@ TEST(MarkerDetectorRealTest, AprilTagDetectUnitCorners) {
       {"34085369442_304b6bafd9_c.jpg", {476, 333}},
       {"34085369442_304b6bafd9_c.jpg", {635, 108}},
       {"34085369442_304b6bafd9_c.jpg", {655, 111}},
+      {"34085369442_304b6bafd9_c.jpg", {749, 114}},
       {"34139872896_defdb2f8d9_c.jpg", {389, 278}},
       {"34139872896_defdb2f8d9_c.jpg", {565, 398}},
       {"34139872896_defdb2f8d9_c.jpg", {772, 348}}};
@@ -470,9 +472,9 @@ TEST(MarkerDetectorRealTest, AprilTagDetectUnitCorners) {
   std::printf("apriltag: %d of %d found within 1 px (worst %.3f px), %d more within 3 px\n",
               matched_total, expected_total, worst_total, near_total);
   EXPECT_EQ(expected_total, 47);
-  EXPECT_GE(matched_total, 43);
-  EXPECT_LE(near_total, 47 - matched_total);
-  EXPECT_GE(unlisted_total, 6);
+  EXPECT_GE(matched_total, 44);
+  EXPECT_EQ(matched_total + near_total, 47);
+  EXPECT_EQ(unlisted_total, 8);
   EXPECT_EQ(wrong_total, 0);
 }
 

@@ -57,6 +57,15 @@ std::optional<Line> FitSide(const cv::Mat& gray, cv::Point2d a, cv::Point2d b,
     }
     // The strongest step must be dark to bright outwards and clear of the noise.
     if (peak < 0 || derivative[peak] * 2.0 < min_step) continue;
+    // The marker's edge is the innermost strong step: further out, a bright surround
+    // beyond the quiet zone may step up again.
+    for (int i = 1; i < peak; ++i) {
+      if (derivative[i] >= 0.5 * derivative[peak] && derivative[i] >= derivative[i - 1] &&
+          derivative[i] >= derivative[i + 1]) {
+        peak = i;
+        break;
+      }
+    }
     double sum = 0.0, moment = 0.0;
     for (int i = std::max(1, peak - 6); i <= std::min<int>(profile.size() - 2, peak + 6); ++i) {
       if (derivative[i] <= 0.0) continue;
