@@ -197,7 +197,7 @@ bool RingDecode(const std::vector<double>& values, int cells,
   return Identify(white, cells, dictionary, options, id, rotation);
 }
 
-// Crops of the ring values to the marker's own cells.
+// The marker's own cells (cells x cells) out of values sampled with the ring.
 std::vector<double> InnerCells(const std::vector<double>& values, int cells) {
   const int n = cells + 2;
   std::vector<double> inner;
