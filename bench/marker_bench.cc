@@ -1,8 +1,10 @@
 // Marker pipeline speed: detection per 640x480 and 1280x720 frame (rendered markers over a
-// textured background), with the small-marker options, IPPE pose per marker, and the camera
-// locator per frame.
+// textured background), with the small-marker options, on a real AprilTag photo, IPPE pose
+// per marker, and the camera locator per frame.
 #include <benchmark/benchmark.h>
 
+#include <opencv2/imgcodecs.hpp>
+#include <string>
 #include <vector>
 
 #include "arucoslam/markers/camera_locator.h"
@@ -77,6 +79,35 @@ BENCHMARK(BM_DetectSmallMarkerOptions)
     ->Args({20, 1})
     ->Args({30, 0})
     ->Unit(benchmark::kMillisecond);
+
+// The real-photo options of the apriltag_detect_unit test (799x533 photo, tag36h11, AprilTag
+// quads at 2x with the rescue decoder, with and without its contour candidates: 1 or 0).
+void BM_DetectAprilTagPhoto(benchmark::State& state) {
+  const std::string path = std::string(ARUCOSLAM_TEST_DATA_DIR) +
+                           "/apriltag_detect_unit/34085369442_304b6bafd9_c.jpg";
+  const cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (image.empty()) {
+    state.SkipWithError("apriltag_detect_unit photo missing");
+    return;
+  }
+  DetectorOptions options;
+  options.dictionary = "DICT_APRILTAG_36h11";
+  options.corner_refinement = CornerRefinement::kAprilTag;
+  options.perspective_remove_pixel_per_cell = 4;
+  options.perspective_remove_ignored_margin_per_cell = 0.25;
+  options.upsample = 2.0;
+  options.rescue_rejected = true;
+  options.rescue_contour_candidates = state.range(0) != 0;
+  const MarkerDetector detector(options);
+  size_t found = 0;
+  for (auto _ : state) {
+    const std::vector<MarkerDetection> detections = detector.Detect(image);
+    found = detections.size();
+    benchmark::DoNotOptimize(detections.data());
+  }
+  state.counters["markers"] = static_cast<double>(found);
+}
+BENCHMARK(BM_DetectAprilTagPhoto)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 void BM_PreprocessClahe(benchmark::State& state) {
   const CameraModel camera = Camera(640, 480);

@@ -7,6 +7,8 @@
 #include <opencv2/core.hpp>
 #include <optional>
 
+#include "arucoslam/markers/edge_refiner.h"
+
 namespace arucoslam {
 
 struct CandidateDecoderOptions {
@@ -23,6 +25,15 @@ struct CandidateDecoderOptions {
   // max_refine_shift_cells (its place is then unsure) is dropped.
   double refine_window_cells = 0.6;      // fraction of a cell, > 0
   double max_refine_shift_cells = 0.75;  // cells, > 0
+  // Corners from the four sides' edges (edge_refiner.h) first; cornerSubPix ones when those
+  // fail or do not decode.
+  bool edge_refinement = true;
+  EdgeRefineOptions edges;
+  // Cells compared with a threshold between the border's black and the quiet zone's white,
+  // both fitted over the marker, after sharpening (cell += sharpening x its Laplacian over
+  // the 4 neighbours); Otsu over the cells when the quiet zone is not white or that fails.
+  bool ring_threshold = true;
+  double sharpening = 0.25;
 
   bool Check() const;
 };

@@ -155,18 +155,43 @@ std::vector<MarkerDetection> MarkerDetector::Detect(const cv::Mat& image) const 
   if (options_.rescue_rejected) {
     CandidateDecoderOptions rescue = options_.rescue;
     rescue.marker_border_bits = options_.marker_border_bits;
-    for (const std::vector<cv::Point2f>& candidate : rejected) {
-      if (candidate.size() != 4) continue;
-      const std::optional<DecodedCandidate> decoded = DecodeCandidate(
-          work, {candidate[0], candidate[1], candidate[2], candidate[3]}, *dictionary_, rescue);
-      if (!decoded) continue;
-      MarkerDetection detection;  // corners refined by the decoder: OpenCV's convention
-      detection.id = decoded->id;
-      for (int k = 0; k < 4; ++k) {
-        detection.corners[k] = {(decoded->corners[k].x + 0.5) / scale - 0.5,
-                                (decoded->corners[k].y + 0.5) / scale - 0.5};
+    // Rejected candidates first; a decoded one that overlaps a marker already found is
+    // dropped (OpenCV's own decoding is kept).
+    const auto rescue_candidates = [&](const std::vector<std::vector<cv::Point2f>>& candidates) {
+      for (const std::vector<cv::Point2f>& candidate : candidates) {
+        if (candidate.size() != 4) continue;
+        const std::optional<DecodedCandidate> decoded = DecodeCandidate(
+            work, {candidate[0], candidate[1], candidate[2], candidate[3]}, *dictionary_, rescue);
+        if (!decoded) continue;
+        MarkerDetection detection;  // corners refined by the decoder: OpenCV's convention
+        detection.id = decoded->id;
+        for (int k = 0; k < 4; ++k) {
+          detection.corners[k] = {(decoded->corners[k].x + 0.5) / scale - 0.5,
+                                  (decoded->corners[k].y + 0.5) / scale - 0.5};
+        }
+        const bool known =
+            std::any_of(detections.begin(), detections.end(), [&](const MarkerDetection& d) {
+              return d.id == detection.id &&
+                     (d.Center() - detection.Center()).norm() <
+                         0.25 * options_.dedup_distance_rate *
+                             std::min(d.Perimeter(), detection.Perimeter());
+            });
+        if (!known) detections.push_back(detection);
       }
-      detections.push_back(detection);
+    };
+    rescue_candidates(rejected);
+    // With AprilTag quads, the contour search of OpenCV's default path finds other
+    // candidates (some small markers only there): they are decoded last.
+    if (options_.corner_refinement == CornerRefinement::kAprilTag &&
+        options_.rescue_contour_candidates) {
+      std::vector<std::vector<cv::Point2f>> contour_corners, contour_rejected;
+      std::vector<int> contour_ids;
+      cv::Ptr<cv::aruco::DetectorParameters> contour_parameters = options_.ToOpenCv();
+      contour_parameters->cornerRefinementMethod = cv::aruco::CORNER_REFINE_NONE;
+      cv::aruco::detectMarkers(work, dictionary_, contour_corners, contour_ids, contour_parameters,
+                               contour_rejected);
+      rescue_candidates(contour_corners);
+      rescue_candidates(contour_rejected);
     }
   }
   return RemoveDuplicateDetections(std::move(detections), options_.dedup_distance_rate);

@@ -79,6 +79,10 @@ struct DetectorOptions {
   // growing with the number of rejected candidates (textured scenes have more).
   bool rescue_rejected = false;
   CandidateDecoderOptions rescue;  // its marker_border_bits is taken from above
+  // kAprilTag refinement with rescue_rejected: the candidates of OpenCV's contour search
+  // are decoded as well (small markers that the AprilTag quads miss). Costs about 10% more
+  // on the AprilTag photos (bench/marker_bench.cc BM_DetectAprilTagPhoto).
+  bool rescue_contour_candidates = true;
 
   bool Check() const;
   cv::Ptr<cv::aruco::DetectorParameters> ToOpenCv() const;

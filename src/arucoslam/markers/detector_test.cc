@@ -91,10 +91,10 @@ Scene RandomScene(int index, std::mt19937& rng) {
 // Issue 2 acceptance: recall >= 99% for a 0.2 m marker up to 4 m, 640x480, fx 500, tilted
 // up to 40 degrees; 50 degrees is measured apart (at 4 m the marker is then 25 x 16 px,
 // under 3 px per cell across). Measured with the default options: 287/288 up to 40 degrees,
-// 90/96 at 50; with rescue_rejected: 288/288 and 91/96. The 50-degree misses are blurred
-// (sigma about 1.1 px) so far that border cells between white neighbours read white even on
-// the true corners (upsampling, finer decoding grids or soft decisions do not recover them
-// without false ids).
+// 90/96 at 50; with rescue_rejected: 288/288 and 94/96 (91/96 before the rescue fitted
+// corners to the sides' edges and thresholded against the quiet zone). The 50-degree misses
+// are blurred (sigma about 1.1 px) so far that border cells between white neighbours read
+// white even on the true corners.
 TEST(MarkerDetectorTest, RecallOnWarpedMarkersUpTo4Metres) {
   DetectorOptions rescue_options;
   rescue_options.rescue_rejected = true;
@@ -162,7 +162,7 @@ TEST(MarkerDetectorTest, RecallOnWarpedMarkersUpTo4Metres) {
     return found_by_tilt[variant][50.0].first / double(found_by_tilt[variant][50.0].second);
   };
   EXPECT_GE(recall_50(0), 0.90);
-  EXPECT_GE(recall_50(1), 0.94);
+  EXPECT_GE(recall_50(1), 0.97);
   EXPECT_EQ(found_by_tilt[1][40.0].first, 96);
 }
 
@@ -397,10 +397,12 @@ bool CornersMatchAsSets(const ExpectedTag& tag, const MarkerDetection& detection
 // pixel convention (centres at 0.5), so they are shifted by -0.5 px to OpenCV's. The tags
 // are 10-45 px wide (2-2.5 px per cell for most, JPEG). OpenCV 4.6 at full resolution finds
 // 22 of 47 (AprilTag quads, 8 px per cell, 0.25 cell margin); upsampled 2x with 4 px per
-// cell and rescue_rejected, 41 within 1 px. Of the other six, two are found with a corner
-// 1.05 and 2.65 px off (an acute corner of a tag seen edge-on) and four are missed (10 and
-// 13 px wide, or in deep shadow). Three more real tags that the expectations lack (checked
-// by eye) are found; any other detection fails the test.
+// cell and rescue_rejected (edge-fitted corners, quiet-zone threshold, contour candidates
+// too), all 47 are found, 44 within 1 px; the other three have a corner 1.14, 1.33 and 2.65
+// px off (the first two on 12 and 19 px tags, the last an acute corner of a tag seen
+// edge-on; the expectations are another detector's corners, not ground truth). The eight
+// real tags that the expectations lack (checked by eye) are found too; any other detection
+// fails the test.
 TEST(MarkerDetectorRealTest, AprilTagDetectUnitCorners) {
   const std::filesystem::path dir = DataDir("apriltag_detect_unit");
   if (!std::filesystem::exists(dir)) GTEST_SKIP() << "test data folder missing: " << dir;
@@ -416,6 +418,11 @@ TEST(MarkerDetectorRealTest, AprilTagDetectUnitCorners) {
   const std::vector<std::pair<std::string, Eigen::Vector2d>> unlisted = {
       {"34085369442_304b6bafd9_c.jpg", {37, 347}},
       {"34085369442_304b6bafd9_c.jpg", {476, 333}},
+      {"34085369442_304b6bafd9_c.jpg", {635, 108}},
+      {"34085369442_304b6bafd9_c.jpg", {655, 111}},
+      {"34085369442_304b6bafd9_c.jpg", {749, 114}},
+      {"34139872896_defdb2f8d9_c.jpg", {389, 278}},
+      {"34139872896_defdb2f8d9_c.jpg", {565, 398}},
       {"34139872896_defdb2f8d9_c.jpg", {772, 348}}};
   int expected_total = 0, matched_total = 0, near_total = 0, unlisted_total = 0, wrong_total = 0;
   double worst_total = 0.0;
@@ -465,9 +472,9 @@ TEST(MarkerDetectorRealTest, AprilTagDetectUnitCorners) {
   std::printf("apriltag: %d of %d found within 1 px (worst %.3f px), %d more within 3 px\n",
               matched_total, expected_total, worst_total, near_total);
   EXPECT_EQ(expected_total, 47);
-  EXPECT_GE(matched_total, 41);
-  EXPECT_LE(near_total, 47 - matched_total);
-  EXPECT_EQ(unlisted_total, 3);
+  EXPECT_GE(matched_total, 44);
+  EXPECT_EQ(matched_total + near_total, 47);
+  EXPECT_EQ(unlisted_total, 8);
   EXPECT_EQ(wrong_total, 0);
 }
 

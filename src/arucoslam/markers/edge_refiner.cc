@@ -1,0 +1,143 @@
+#include "arucoslam/markers/edge_refiner.h"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <vector>
+
+namespace arucoslam {
+namespace {
+
+double GreyAt(const cv::Mat& gray, double x, double y) {
+  x = std::clamp(x, 0.0, gray.cols - 1.001);
+  y = std::clamp(y, 0.0, gray.rows - 1.001);
+  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+  const double ax = x - x0, ay = y - y0;
+  const uchar* row0 = gray.ptr<uchar>(y0);
+  const uchar* row1 = gray.ptr<uchar>(y0 + 1);
+  return (1 - ay) * ((1 - ax) * row0[x0] + ax * row0[x0 + 1]) +
+         ay * ((1 - ax) * row1[x0] + ax * row1[x0 + 1]);
+}
+
+// A line n.p = c with unit normal n.
+struct Line {
+  cv::Point2d normal;
+  double offset;
+};
+
+// Fits the edge along side a->b whose outward normal is `outward`: at points spread along
+// the side, the grey profile across it is read and the dark-to-bright step located as the
+// centroid of the outward derivative around its strongest (positive) peak. nullopt with
+// too few edge points.
+std::optional<Line> FitSide(const cv::Mat& gray, cv::Point2d a, cv::Point2d b,
+                            cv::Point2d outward, double search_px, double min_fraction,
+                            double min_step) {
+  const double length = cv::norm(b - a);
+  const int samples = std::clamp(static_cast<int>(length / 1.5), 4, 24);
+  const double step = 0.25;  // px along the normal
+  const int half = std::max(2, static_cast<int>(std::ceil(search_px / step)));
+  std::vector<cv::Point2d> points;
+  std::vector<double> weights;
+  std::vector<double> profile(2 * half + 3);
+  for (int s = 0; s < samples; ++s) {
+    // Stay off the corners, where the neighbouring side's edge would pull.
+    const double t = 0.12 + 0.76 * (s + 0.5) / samples;
+    const cv::Point2d p = a + t * (b - a);
+    for (int k = -half - 1; k <= half + 1; ++k) {
+      const cv::Point2d q = p + (k * step) * outward;
+      profile[k + half + 1] = GreyAt(gray, q.x, q.y);
+    }
+    // Derivative over +-1 px (differences of 4 steps each way): steady on noisy JPEG.
+    std::vector<double> derivative(profile.size(), 0.0);
+    int peak = -1;
+    for (int i = 1; i + 1 < static_cast<int>(profile.size()); ++i) {
+      const int lo = std::max(0, i - 4), hi = std::min<int>(profile.size() - 1, i + 4);
+      derivative[i] = (profile[hi] - profile[lo]) / ((hi - lo) * step);
+      if (peak < 0 || std::abs(derivative[i]) > std::abs(derivative[peak])) peak = i;
+    }
+    // The strongest step must be dark to bright outwards and clear of the noise.
+    if (peak < 0 || derivative[peak] * 2.0 < min_step) continue;
+    // The marker's edge is the innermost strong step: further out, a bright surround
+    // beyond the quiet zone may step up again.
+    for (int i = 1; i < peak; ++i) {
+      if (derivative[i] >= 0.5 * derivative[peak] && derivative[i] >= derivative[i - 1] &&
+          derivative[i] >= derivative[i + 1]) {
+        peak = i;
+        break;
+      }
+    }
+    double sum = 0.0, moment = 0.0;
+    for (int i = std::max(1, peak - 6); i <= std::min<int>(profile.size() - 2, peak + 6); ++i) {
+      if (derivative[i] <= 0.0) continue;
+      sum += derivative[i];
+      moment += derivative[i] * (i - half - 1) * step;
+    }
+    points.push_back(p + (moment / sum) * outward);
+    weights.push_back(derivative[peak]);
+  }
+  if (points.size() < std::max<size_t>(3, static_cast<size_t>(min_fraction * samples))) {
+    return std::nullopt;
+  }
+  // Weighted total least squares.
+  double w_sum = 0.0;
+  cv::Point2d mean(0, 0);
+  for (size_t i = 0; i < points.size(); ++i) {
+    w_sum += weights[i];
+    mean += weights[i] * points[i];
+  }
+  mean *= 1.0 / w_sum;
+  double sxx = 0.0, sxy = 0.0, syy = 0.0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const cv::Point2d d = points[i] - mean;
+    sxx += weights[i] * d.x * d.x;
+    sxy += weights[i] * d.x * d.y;
+    syy += weights[i] * d.y * d.y;
+  }
+  const double angle = 0.5 * std::atan2(2.0 * sxy, sxx - syy);  // direction of the line
+  const cv::Point2d normal(-std::sin(angle), std::cos(angle));
+  return Line{normal, normal.dot(mean)};
+}
+
+std::optional<cv::Point2d> Intersect(const Line& l1, const Line& l2) {
+  const double det = l1.normal.x * l2.normal.y - l1.normal.y * l2.normal.x;
+  if (std::abs(det) < 1e-6) return std::nullopt;
+  return cv::Point2d((l1.offset * l2.normal.y - l2.offset * l1.normal.y) / det,
+                     (l1.normal.x * l2.offset - l2.normal.x * l1.offset) / det);
+}
+
+}  // namespace
+
+bool RefineQuadEdges(const cv::Mat& gray, int cells, const EdgeRefineOptions& options,
+                     std::array<cv::Point2f, 4>& corners) {
+  const std::array<cv::Point2f, 4> start = corners;
+  double perimeter = 0.0;
+  for (int k = 0; k < 4; ++k) perimeter += cv::norm(corners[(k + 1) % 4] - corners[k]);
+  const double cell = 0.25 * perimeter / cells;
+  std::array<cv::Point2d, 4> current;
+  for (int k = 0; k < 4; ++k) current[k] = corners[k];
+  for (int iteration = 0; iteration < options.iterations; ++iteration) {
+    std::array<Line, 4> lines;
+    for (int k = 0; k < 4; ++k) {
+      const cv::Point2d a = current[k], b = current[(k + 1) % 4];
+      const cv::Point2d along = (b - a) * (1.0 / std::max(1e-9, cv::norm(b - a)));
+      // Clockwise on screen with y down: the outside is on the left of a->b.
+      const cv::Point2d outward(along.y, -along.x);
+      const std::optional<Line> line = FitSide(gray, a, b, outward, options.search_cells * cell,
+                                               options.min_edge_fraction, options.min_step);
+      if (!line) return false;
+      lines[k] = *line;
+    }
+    for (int k = 0; k < 4; ++k) {
+      const std::optional<cv::Point2d> corner = Intersect(lines[(k + 3) % 4], lines[k]);
+      if (!corner) return false;
+      current[k] = *corner;
+    }
+  }
+  for (int k = 0; k < 4; ++k) {
+    if (cv::norm(current[k] - cv::Point2d(start[k])) > options.max_shift_cells * cell) return false;
+  }
+  for (int k = 0; k < 4; ++k) corners[k] = cv::Point2f(current[k]);
+  return true;
+}
+
+}  // namespace arucoslam
