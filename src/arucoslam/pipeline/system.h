@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 
 #include <atomic>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -20,6 +21,7 @@
 #include "arucoslam/markers/detector.h"
 #include "arucoslam/markers/marker_map.h"
 #include "arucoslam/pipeline/bounded_queue.h"
+#include "arucoslam/pipeline/place_recognition.h"
 #include "arucoslam/slam/initializer.h"
 #include "arucoslam/slam/keyframe_policy.h"
 #include "arucoslam/slam/local_mapper.h"
@@ -76,6 +78,11 @@ struct SystemOptions {
   // aligned (the poses already output are kept).
   int marker_reset_lost_frames = 10;
 
+  // Bag-of-words vocabulary. When set, keyframes enter a place database: lost tracking is
+  // relocalised from it and, with places.loop_closing, loops are closed. Null: neither.
+  std::shared_ptr<const Vocabulary> vocabulary;
+  PlaceRecognitionOptions places;
+
   bool Check() const;
 };
 
@@ -113,6 +120,7 @@ struct SystemStats {
   int num_marker_only_poses = 0;  // frames whose pose came from markers alone
   int num_world_alignments = 0;
   int num_marker_relocalizations = 0;  // tracking restarted from a marker pose
+  PlaceRecognitionStats places;        // relocalisation and loops (with a vocabulary)
 };
 
 struct StampedPose {
@@ -177,6 +185,16 @@ class System {
   // pose in the map) is carried along.
   void MaybeAlignWorld(Frame* frame);
   void RecordMarkerPose(const Frame& frame, FrameReport& report);
+  // Place recognition (system_places.cc).
+  void MakePlaceRecognition();
+  bool RelocalizeWithPlaces(Frame& frame, FrameReport& report);
+  // After a loop correction or global BA: the tracker's last pose follows its reference
+  // keyframe into the corrected map. Also re-anchors poses whose reference keyframe was
+  // culled to the keyframe nearest in time, so that later corrections move them too.
+  void FollowMapCorrections();
+  void ReanchorOrphanPoses();
+  // Held while the map is moved from outside (world alignment); empty without places.
+  std::unique_lock<std::mutex> LockPlacesForMapMove();
   void MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& report);
   void MapKeyframe(KeyframeId keyframe);
   void RecordPose(const Frame& frame, KeyframeId reference);
@@ -207,6 +225,10 @@ class System {
   int next_alignment_anchors_ = 0;  // alignment is tried again at this many anchors
   int lost_with_markers_ = 0;
   double detection_ms_ = 0.0;  // marker detection time of the current image
+
+  std::unique_ptr<PlaceRecognition> places_;  // with a vocabulary only
+  std::uint64_t seen_corrections_ = 0;
+  std::map<KeyframeId, Rigid3> keyframe_poses_;  // as of the previous frame (re-anchoring)
 
   std::unique_ptr<BoundedQueue<KeyframeId>> queue_;
   std::thread mapping_thread_;

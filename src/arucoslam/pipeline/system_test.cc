@@ -37,10 +37,18 @@ struct RunResult {
   std::string invariants;
 };
 
-RunResult RunSynthetic(bool blocking, int num_frames, bool moving = true) {
+std::shared_ptr<const Vocabulary> ShippedVocabulary() {
+  static const auto vocabulary = std::make_shared<const Vocabulary>(Vocabulary::Load(
+      std::filesystem::path(ARUCOSLAM_SOURCE_DIR) / "data" / "vocabulary" / "orb_k10_l5.bin"));
+  return vocabulary;
+}
+
+RunResult RunSynthetic(bool blocking, int num_frames, bool moving = true,
+                       std::shared_ptr<const Vocabulary> vocabulary = nullptr) {
   SyntheticFeatureScene scene(TestCamera());
   SystemOptions options;
   options.blocking = blocking;
+  options.vocabulary = std::move(vocabulary);
   System system(TestCamera(), options);
   RunResult run;
   std::vector<int> truth;
@@ -118,6 +126,20 @@ TEST(System, ThreadedRunTracksSyntheticSequence) {
   EXPECT_GE(static_cast<int>(run.trajectory.size()), 0.95 * (num_frames - run.first_initialised));
   EXPECT_EQ(run.invariants, "");
   EXPECT_LT(AlignedRmsError(run.trajectory), 0.024);
+}
+
+TEST(System, PlaceRecognitionAlongsideThreadedMappingKeepsTheRunIntact) {
+  // Keyframes go through the database and loop detection on their own thread; the route
+  // never comes back, so nothing may be closed and the result matches the plain run.
+  const int num_frames = 80;
+  const RunResult run = RunSynthetic(false, num_frames, true, ShippedVocabulary());
+  ASSERT_GE(run.first_initialised, 1);
+  EXPECT_GE(static_cast<int>(run.trajectory.size()), 0.95 * (num_frames - run.first_initialised));
+  EXPECT_EQ(run.invariants, "");
+  EXPECT_LT(AlignedRmsError(run.trajectory), 0.024);
+  EXPECT_GE(run.stats.places.loop_detection_ms.Count(), 1u);  // the loop thread ran
+  EXPECT_TRUE(run.stats.places.loops.empty());
+  EXPECT_EQ(run.stats.places.num_relocalizations, 0);
 }
 
 TEST(System, StaticSyntheticCameraNeverInitialises) {
