@@ -71,6 +71,7 @@ void System::MapKeyframe(KeyframeId keyframe) {
   const double elapsed = watch.ElapsedMilliseconds();
   if (places_) {
     edit.unlock();
+    if (options_.blocking) ReanchorOrphanPoses();  // before a loop correction moves the map
     places_->KeyframeMapped(keyframe);
   }
   ARUCOSLAM_LOG_DEBUG(
