@@ -85,8 +85,6 @@ class PlaceRecognition {
   void MapMovedExternally();
   // The loop closer keeps the monocular scale fixed once the map is metric (markers).
   void SetMetricMap(bool metric);
-  // Turns loop detection on or off (blocking mode, or before the first keyframe).
-  void SetLoopClosing(bool on) { options_.loop_closing = on; }
   // Incremented by each closed loop and applied global BA: the tracking thread re-anchors
   // its last pose to its reference keyframe when this changes.
   std::uint64_t corrections() const { return corrections_; }
