@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "arucoslam/exe/command.h"
+#include "arucoslam/exe/default_vocabulary.h"
 #include "arucoslam/exe/slam_run.h"
 #include "arucoslam/io/dataset_reader.h"
 #include "arucoslam/io/marker_map_json.h"
@@ -23,6 +24,8 @@ struct RunArgs {
   std::string dataset;
   std::string out;
   std::string camera;
+  std::string vocabulary;  // empty: the default one
+  bool no_loop_closing = false;
   bool no_markers = false;
   bool blocking = false;
   bool quiet = false;
@@ -70,6 +73,10 @@ int RunSlam(const RunArgs& args) {
     options.marker_map = ReadMarkerMapJson(*markers_path);
     options.detector.dictionary = options.marker_map->dictionary;
   }
+  const std::filesystem::path vocabulary =
+      args.vocabulary.empty() ? DefaultVocabularyPath() : std::filesystem::path(args.vocabulary);
+  options.vocabulary = std::make_shared<const Vocabulary>(Vocabulary::Load(vocabulary));
+  options.places.loop_closing = !args.no_loop_closing;
   const bool markers = options.marker_map.has_value();
   MapReuse reuse;
   if (!args.load_map.empty()) LoadMapForRun(args.load_map, dataset.camera(), reuse);
@@ -103,6 +110,11 @@ void AddRunCommand(CLI::App& app, int& exit_status) {
                 "ignore the sequence's markers.json (keypoints only). Without this flag a "
                 "markers.json in the sequence puts the run in the marker world frame, with "
                 "metric scale and marker relocalisation");
+  run->add_option("--vocabulary", args->vocabulary,
+                  "bag-of-words vocabulary for relocalisation and loop closing (default: " +
+                      std::string(kDefaultVocabularyName) + " shipped with arucoslam)");
+  run->add_flag("--no-loop-closing", args->no_loop_closing,
+                "do not detect or close loops (relocalisation stays on)");
   run->add_flag("--blocking", args->blocking,
                 "track and map each frame in turn on one thread (deterministic)");
   run->add_flag("--quiet", args->quiet, "no progress line");

@@ -152,6 +152,26 @@ TEST_F(RunCommandTest, MovingCameraOverPlaneIsTracked) {
   EXPECT_EQ(outcome.err.find("\rframe"), std::string::npos);  // --quiet
 }
 
+TEST_F(RunCommandTest, MissingOrCorruptVocabularyIsOneLineAndExitTwo) {
+  if (!fs::exists(fs::path(ARUCOSLAM_TEST_DATA_DIR) / "euroc_v101_micro")) {
+    GTEST_SKIP() << "test data missing: euroc_v101_micro";
+  }
+  const fs::path images = MakePlaneSequence(dir_, 3);
+  const fs::path out = dir_ / "out";
+  const std::string run = "run --dataset " + images.string() + " --camera " +
+                          (dir_ / "camera.yaml").string() + " --rate 20 --out " + out.string();
+  Outcome outcome = Run(run + " --vocabulary " + (dir_ / "none.bin").string());
+  EXPECT_EQ(outcome.status, 2);
+  EXPECT_NE(outcome.err.find("none.bin"), std::string::npos) << outcome.err;
+  EXPECT_EQ(CountLines(outcome.err, '\0'), 1) << outcome.err;
+  WriteTextFileAtomically(dir_ / "corrupt.bin", "not a vocabulary");
+  outcome = Run(run + " --vocabulary " + (dir_ / "corrupt.bin").string());
+  EXPECT_EQ(outcome.status, 2);
+  EXPECT_NE(outcome.err.find("corrupt.bin"), std::string::npos) << outcome.err;
+  EXPECT_EQ(CountLines(outcome.err, '\0'), 1) << outcome.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 TEST_F(RunCommandTest, BadInputIsOneLineAndExitTwo) {
   const fs::path out = dir_ / "out";
   Outcome outcome = Run("run --dataset " + (dir_ / "missing").string() + " --out " + out.string());

@@ -31,7 +31,11 @@ SlamRunStats MakeStats(const std::string& dataset_label, const Dataset& dataset,
   out.frames_tracked = stats.num_tracked;
   out.frames_lost = stats.num_lost;
   out.losses = stats.num_losses;
-  out.relocalisations = stats.num_marker_relocalizations + stats.num_map_relocalizations;
+  // From the place database, marker poses and keyframe matches in a loaded map.
+  out.relocalisations = stats.places.num_relocalizations + stats.num_marker_relocalizations +
+                        stats.num_map_relocalizations;
+  out.loops_closed = static_cast<int>(stats.places.loops.size());
+  out.global_bundle_adjustments = stats.places.num_global_bundle_adjustments;
   out.initialization_attempts = stats.num_initialization_attempts;
   out.initializations = stats.num_initializations;
   out.resets = stats.num_resets;
@@ -44,6 +48,14 @@ SlamRunStats MakeStats(const std::string& dataset_label, const Dataset& dataset,
                     {"tracking", stats.tracking_ms.Summarize()},
                     {"frame", stats.frame_ms.Summarize()},
                     {"local_mapping", stats.local_mapping_ms.Summarize()}};
+  if (stats.places.loop_detection_ms.Count() > 0 ||
+      stats.places.num_relocalization_attempts > 0) {
+    out.timings_ms.push_back({"relocalisation", stats.places.relocalization_ms.Summarize()});
+    out.timings_ms.push_back({"loop_detection", stats.places.loop_detection_ms.Summarize()});
+    out.timings_ms.push_back({"loop_correction", stats.places.loop_correction_ms.Summarize()});
+    out.timings_ms.push_back(
+        {"global_bundle_adjustment", stats.places.global_bundle_adjustment_ms.Summarize()});
+  }
   return out;
 }
 

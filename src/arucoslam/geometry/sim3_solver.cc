@@ -193,6 +193,20 @@ double InlierRms(const CameraModel& current_camera, const CameraModel& candidate
   return count > 0 ? std::sqrt(sum / count) : 0.0;
 }
 
+// Distance between the two camera centres (candidate frame) over the inliers' median depth in
+// the candidate camera; 0 without inliers.
+double BaselineDepthRatio(const std::vector<Sim3Correspondence>& correspondences,
+                          const std::vector<bool>& inliers, const Sim3& candidate_from_current) {
+  std::vector<double> depths;
+  for (std::size_t i = 0; i < correspondences.size(); ++i) {
+    if (inliers[i]) depths.push_back(correspondences[i].p_in_candidate.z());
+  }
+  if (depths.empty()) return 0.0;
+  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
+  const double median = depths[depths.size() / 2];
+  return median > 0.0 ? candidate_from_current.translation.norm() / median : 0.0;
+}
+
 // RANSAC over minimal samples; returns the best model and its inlier count.
 std::optional<Sim3> Ransac(const CameraModel& current_camera, const CameraModel& candidate_camera,
                            const std::vector<Sim3Correspondence>& correspondences,
@@ -234,7 +248,8 @@ std::optional<Sim3> Ransac(const CameraModel& current_camera, const CameraModel&
 bool Sim3SolverOptions::Check() const {
   return max_ransac_iterations > 0 && confidence > 0.0 && confidence < 1.0 &&
          chi_square_threshold > 0.0 && min_inliers >= 3 && refine_iterations >= 0 &&
-         huber_delta > 0.0;
+         huber_delta > 0.0 && min_scale_baseline_ratio >= 0.0 && min_scale > 0.0 &&
+         max_scale >= min_scale;
 }
 
 Eigen::Vector2d Sim3ChiSquares(const CameraModel& current_camera,
@@ -286,8 +301,10 @@ Sim3SolverResult SolveSim3(const CameraModel& current_camera, const CameraModel&
     }
   }
   if (options.refine_iterations > 0) {
-    RefineProblem problem{
-        current_camera, candidate_camera, {}, options.huber_delta, options.fix_scale ? 6 : 7};
+    const bool scale_observable =
+        BaselineDepthRatio(correspondences, set.inliers, model) >= options.min_scale_baseline_ratio;
+    RefineProblem problem{current_camera, candidate_camera, {}, options.huber_delta,
+                          options.fix_scale || !scale_observable ? 6 : 7};
     for (std::size_t i = 0; i < correspondences.size(); ++i) {
       if (set.inliers[i]) problem.matches.push_back(&correspondences[i]);
     }
@@ -300,6 +317,10 @@ Sim3SolverResult SolveSim3(const CameraModel& current_camera, const CameraModel&
   result.num_inliers = set.count;
   result.inlier_rms_px =
       InlierRms(current_camera, candidate_camera, correspondences, set.inliers, model);
+  if (!(model.scale >= options.min_scale && model.scale <= options.max_scale)) {
+    result.message = "implausible scale " + std::to_string(model.scale);
+    return result;
+  }
   result.success = set.count >= options.min_inliers;
   if (!result.success) result.message = "too few inliers";
   return result;

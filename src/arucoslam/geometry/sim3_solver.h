@@ -39,6 +39,13 @@ struct Sim3SolverOptions {
   int refine_iterations = 10;
   // Huber threshold of the refinement on the whitened residual (sqrt of the chi-square).
   double huber_delta = 3.0348;  // sqrt(9.21)
+  // Reprojection errors fix the scale only through the translation between the cameras: when
+  // it is below this fraction of the median depth of the inliers (candidate side) the
+  // refinement keeps the scale of the 3D fit (at zero baseline it could drift to zero).
+  double min_scale_baseline_ratio = 0.05;
+  // A scale outside [min_scale, max_scale] is no loop (monocular drift is never that large).
+  double min_scale = 0.1;
+  double max_scale = 10.0;
   std::uint32_t seed = 1;       // random sampling, deterministic for a seed
 
   bool Check() const;

@@ -138,6 +138,32 @@ TEST(Sim3SolverTest, FixedScaleRejectsAScaledLoop) {
   EXPECT_FALSE(SolveSim3(MakeCamera(), MakeCamera(), scene.correspondences, options).success);
 }
 
+TEST(Sim3SolverTest, ZeroBaselineKeepsTheScaleOfThePoints) {
+  // The loop keyframe was taken from the same place (no translation between the cameras):
+  // the reprojection errors no longer depend on the scale, only the 3D points fix it.
+  for (const double scale : {1.0, 0.6, 1.8}) {
+    const Sim3 truth(scale, kTruth.rotation, Eigen::Vector3d::Zero());
+    const Scene scene = MakeScene(truth, 200, 0.3, 17);
+    Sim3SolverOptions options;
+    options.refine_iterations = 100;  // room to drift along the unobservable scale
+    const Sim3SolverResult result =
+        SolveSim3(MakeCamera(), MakeCamera(), scene.correspondences, options);
+    ASSERT_TRUE(result.success) << result.message;
+    EXPECT_NEAR(result.candidate_from_current.scale, scale, 0.01 * scale);  // 3% off unfixed
+    EXPECT_LT(result.candidate_from_current.translation.norm(), 0.05 * scale);
+    ExpectClassification(scene, result);
+  }
+}
+
+TEST(Sim3SolverTest, RejectsAnImplausibleScale) {
+  // Matches consistent with a collapse of the current map by 50: no loop does that.
+  const Sim3 collapse(0.02, kTruth.rotation, Eigen::Vector3d(0.01, 0.0, 0.0));
+  const Scene scene = MakeScene(collapse, 200, 0.0, 19);
+  const Sim3SolverResult result = SolveSim3(MakeCamera(), MakeCamera(), scene.correspondences);
+  EXPECT_FALSE(result.success);
+  EXPECT_NE(result.message.find("scale"), std::string::npos) << result.message;
+}
+
 TEST(Sim3SolverTest, FailsOnRandomMatches) {
   const Scene scene = MakeScene(kTruth, 200, 1.0, 11);
   const Sim3SolverResult result = SolveSim3(MakeCamera(), MakeCamera(), scene.correspondences);

@@ -40,7 +40,9 @@ std::string FormatSlamStatsJson(const SlamRunStats& stats) {
                       {"resets", stats.resets}};
   json["map"] = {{"keyframes", stats.keyframes},
                  {"keyframes_inserted", stats.keyframes_inserted},
-                 {"points", stats.map_points}};
+                 {"points", stats.map_points},
+                 {"loops_closed", stats.loops_closed},
+                 {"global_bundle_adjustments", stats.global_bundle_adjustments}};
   nlohmann::ordered_json timings = nlohmann::ordered_json::object();
   for (const auto& [stage, summary] : stats.timings_ms) {
     timings[stage] = {{"count", summary.count},

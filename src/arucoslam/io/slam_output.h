@@ -26,6 +26,8 @@ struct SlamRunStats {
   int frames_lost = 0;
   int losses = 0;          // transitions tracking -> lost
   int relocalisations = 0;
+  int loops_closed = 0;
+  int global_bundle_adjustments = 0;  // applied after loop closures
   int initialization_attempts = 0;
   int initializations = 0;
   int resets = 0;
@@ -41,7 +43,8 @@ struct SlamRunStats {
 // ASCII PLY with one vertex (x y z, double) per point.
 std::string FormatPlyPoints(const std::vector<Eigen::Vector3d>& points);
 // stats.json text: {"format": "arucoslam.stats/1", "dataset", "frames": {...},
-// "tracking": {"losses", "relocalisations", ...}, "map": {...}, "timings_ms": {stage:
+// "tracking": {"losses", "relocalisations", ...}, "map": {..., "loops_closed",
+// "global_bundle_adjustments"}, "timings_ms": {stage:
 // {count, mean, median, p95, max}}, "wall_time_s", "peak_memory_bytes"}.
 std::string FormatSlamStatsJson(const SlamRunStats& stats);
 

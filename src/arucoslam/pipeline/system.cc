@@ -15,7 +15,7 @@ bool SystemOptions::Check() const {
          locator.Check() && alignment.Check() && max_marker_rms_px > 0.0 &&
          min_alignment_anchors >= 2 && min_alignment_baseline_m >= 0.0 &&
          max_alignment_rms_m > 0.0 && marker_reset_lost_frames >= 1 &&
-         max_realignment_anchors >= min_alignment_anchors;
+         max_realignment_anchors >= min_alignment_anchors && places.Check();
 }
 
 System::System(const CameraModel& camera, const SystemOptions& options)
@@ -28,6 +28,7 @@ System::System(const CameraModel& camera, const SystemOptions& options)
   tracker_ = std::make_unique<Tracker>(*map_, options_.tracker);
   mapper_ = std::make_unique<LocalMapper>(*map_, options_.mapper);
   if (options_.marker_map) detector_ = std::make_unique<MarkerDetector>(options_.detector);
+  MakePlaceRecognition();
   StartMappingThread();
 }
 
@@ -54,6 +55,7 @@ void System::Finish() {
   if (finished_) return;
   finished_ = true;
   StopMappingThread();
+  if (places_) places_->Finish();
 }
 
 bool System::MapperIdle() const {
@@ -63,8 +65,15 @@ bool System::MapperIdle() const {
 
 void System::MapKeyframe(KeyframeId keyframe) {
   const Stopwatch watch;
+  std::unique_lock<std::mutex> edit;  // a loop being closed pauses local mapping
+  if (places_) edit = places_->LockMapEdits();
   const LocalMappingResult r = mapper_->ProcessKeyframe(keyframe);
   const double elapsed = watch.ElapsedMilliseconds();
+  if (places_) {
+    edit.unlock();
+    if (options_.blocking) ReanchorOrphanPoses();  // before a loop correction moves the map
+    places_->KeyframeMapped(keyframe);
+  }
   ARUCOSLAM_LOG_DEBUG(
       "keyframe {}: {} culled, {} new ({:.0f} ms), {} fused ({:.0f} ms), BA {} kf {} pts "
       "rms {:.2f}->{:.2f} px, {} outliers ({:.0f} ms), {} keyframes culled; {:.0f} ms",
@@ -183,6 +192,10 @@ void System::Initialize(Frame& frame, FrameReport& report) {
     }
   }
   RecordPose(frame, created.second);
+  if (places_) {
+    places_->KeyframeMapped(created.first);
+    places_->KeyframeMapped(created.second);
+  }
   AddAnchor(created.first, init_reference_fix_);
   AddAnchor(created.second, fix_);
   init_reference_fix_.reset();
@@ -202,9 +215,11 @@ void System::Initialize(Frame& frame, FrameReport& report) {
 
 void System::Track(Frame& frame, FrameReport& report) {
   static const std::vector<MarkerPoseObservation> kNoMarkers;
+  FollowMapCorrections();
   TrackingResult result = tracker_->Track(frame, world_aligned_ && fix_ ? fix_->markers : kNoMarkers);
   if (result.state != TrackingState::kTracking &&
-      (RelocalizeWithMarkers(frame, report) || RelocalizeInLoadedMap(frame, report))) {
+      (RelocalizeWithMarkers(frame, report) || RelocalizeWithPlaces(frame, report) ||
+       RelocalizeInLoadedMap(frame, report))) {
     result.state = TrackingState::kTracking;
     result.num_inliers = report.num_inliers;
   }
@@ -298,11 +313,13 @@ void System::ResetMap() {
     }
     return 0;
   });
+  places_.reset();
   tracker_.reset();
   mapper_.reset();
   map_ = std::make_unique<Map>();
   tracker_ = std::make_unique<Tracker>(*map_, options_.tracker);
   mapper_ = std::make_unique<LocalMapper>(*map_, options_.mapper);
+  MakePlaceRecognition();
   poses_ = std::move(kept);
   init_reference_.reset();
   init_reference_fix_.reset();

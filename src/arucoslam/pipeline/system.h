@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 
 #include <atomic>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -20,6 +21,7 @@
 #include "arucoslam/markers/detector.h"
 #include "arucoslam/markers/marker_map.h"
 #include "arucoslam/pipeline/bounded_queue.h"
+#include "arucoslam/pipeline/place_recognition.h"
 #include "arucoslam/slam/initializer.h"
 #include "arucoslam/slam/keyframe_policy.h"
 #include "arucoslam/slam/local_mapper.h"
@@ -76,6 +78,11 @@ struct SystemOptions {
   // aligned (the poses already output are kept).
   int marker_reset_lost_frames = 10;
 
+  // Bag-of-words vocabulary. When set, keyframes enter a place database: lost tracking is
+  // relocalised from it and, with places.loop_closing, loops are closed. Null: neither.
+  std::shared_ptr<const Vocabulary> vocabulary;
+  PlaceRecognitionOptions places;
+
   bool Check() const;
 };
 
@@ -114,6 +121,7 @@ struct SystemStats {
   int num_world_alignments = 0;
   int num_marker_relocalizations = 0;  // tracking restarted from a marker pose
   int num_map_relocalizations = 0;     // loaded map: restarted from a keyframe match
+  PlaceRecognitionStats places;        // relocalisation and loops (with a vocabulary)
 };
 
 struct StampedPose {
@@ -191,6 +199,16 @@ class System {
   // pose in the map) is carried along.
   void MaybeAlignWorld(Frame* frame);
   void RecordMarkerPose(const Frame& frame, FrameReport& report);
+  // Place recognition (system_places.cc).
+  void MakePlaceRecognition();
+  bool RelocalizeWithPlaces(Frame& frame, FrameReport& report);
+  // After a loop correction or global BA: the tracker's last pose follows its reference
+  // keyframe into the corrected map. Also re-anchors poses whose reference keyframe was
+  // culled to the keyframe nearest in time, so that later corrections move them too.
+  void FollowMapCorrections();
+  void ReanchorOrphanPoses();
+  // Held while the map is moved from outside (world alignment); empty without places.
+  std::unique_lock<std::mutex> LockPlacesForMapMove();
   void MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& report);
   void MapKeyframe(KeyframeId keyframe);
   void RecordPose(const Frame& frame, KeyframeId reference);
@@ -225,6 +243,9 @@ class System {
   bool map_loaded_ = false;    // started from a saved map (StartFromMap)
   bool localize_only_ = false;
   std::size_t next_seed_keyframe_ = 0;  // round-robin position of SeedPoseFromKeyframes
+  std::unique_ptr<PlaceRecognition> places_;  // with a vocabulary only
+  std::uint64_t seen_corrections_ = 0;
+  std::map<KeyframeId, Rigid3> keyframe_poses_;  // as of the previous frame (re-anchoring)
 
   std::unique_ptr<BoundedQueue<KeyframeId>> queue_;
   std::thread mapping_thread_;

@@ -33,13 +33,18 @@ void System::StartFromMap(MapData map, bool world_aligned, bool localize_only) {
   map_loaded_ = true;
   localize_only_ = localize_only;
   world_aligned_ = world_aligned;
+  if (places_) {
+    places_->SetMetricMap(world_aligned);
+    places_->IndexExistingKeyframes();
+  }
   // An aligned map is not aligned again (AddAnchor stops collecting anchors).
   if (world_aligned) next_alignment_anchors_ = options_.max_realignment_anchors + 1;
 }
 
 void System::LocalizeInLoadedMap(Frame& frame, FrameReport& report) {
   report.state = TrackingState::kNotInitialized;
-  if (!RelocalizeWithMarkers(frame, report) && !RelocalizeInLoadedMap(frame, report)) {
+  if (!RelocalizeWithMarkers(frame, report) && !RelocalizeWithPlaces(frame, report) &&
+      !RelocalizeInLoadedMap(frame, report)) {
     report.message = "not localised in the loaded map";
     return;
   }
@@ -51,7 +56,8 @@ void System::LocalizeInLoadedMap(Frame& frame, FrameReport& report) {
 }
 
 bool System::RelocalizeInLoadedMap(Frame& frame, FrameReport& report) {
-  if (!map_loaded_) return false;
+  // Brute-force keyframe matching, for a loaded map without a place database only.
+  if (!map_loaded_ || places_) return false;
   const std::optional<Rigid3> seed = SeedPoseFromKeyframes(frame);
   if (!seed) return false;
   const TrackingResult result = tracker_->TrackFromPose(frame, *seed);

@@ -113,6 +113,7 @@ void System::MaybeAlignWorld(Frame* frame) {
   }
   const Sim3& world_from_map = alignment.world_from_map;
   StopMappingThread();  // every queued keyframe is mapped first; mapping is idle below
+  const std::unique_lock<std::mutex> places_lock = LockPlacesForMapMove();
   map_->Write([&](MapData& data) { ApplyWorldAlignment(world_from_map, &data); });
   tracker_->ApplySimilarity(world_from_map);
   const auto to_world = [&](const Rigid3& cam_from_map) {

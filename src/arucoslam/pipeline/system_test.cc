@@ -37,10 +37,18 @@ struct RunResult {
   std::string invariants;
 };
 
-RunResult RunSynthetic(bool blocking, int num_frames, bool moving = true) {
+std::shared_ptr<const Vocabulary> ShippedVocabulary() {
+  static const auto vocabulary = std::make_shared<const Vocabulary>(Vocabulary::Load(
+      std::filesystem::path(ARUCOSLAM_SOURCE_DIR) / "data" / "vocabulary" / "orb_k10_l5.bin"));
+  return vocabulary;
+}
+
+RunResult RunSynthetic(bool blocking, int num_frames, bool moving = true,
+                       std::shared_ptr<const Vocabulary> vocabulary = nullptr) {
   SyntheticFeatureScene scene(TestCamera());
   SystemOptions options;
   options.blocking = blocking;
+  options.vocabulary = std::move(vocabulary);
   System system(TestCamera(), options);
   RunResult run;
   std::vector<int> truth;
@@ -118,6 +126,75 @@ TEST(System, ThreadedRunTracksSyntheticSequence) {
   EXPECT_GE(static_cast<int>(run.trajectory.size()), 0.95 * (num_frames - run.first_initialised));
   EXPECT_EQ(run.invariants, "");
   EXPECT_LT(AlignedRmsError(run.trajectory), 0.024);
+}
+
+TEST(System, PlaceRecognitionAlongsideThreadedMappingKeepsTheRunIntact) {
+  // Keyframes go through the database and loop detection on their own thread; the route
+  // never comes back, so nothing may be closed and the result matches the plain run.
+  const int num_frames = 80;
+  const RunResult run = RunSynthetic(false, num_frames, true, ShippedVocabulary());
+  ASSERT_GE(run.first_initialised, 1);
+  EXPECT_GE(static_cast<int>(run.trajectory.size()), 0.95 * (num_frames - run.first_initialised));
+  EXPECT_EQ(run.invariants, "");
+  EXPECT_LT(AlignedRmsError(run.trajectory), 0.024);
+  EXPECT_GE(run.stats.places.loop_detection_ms.Count(), 1u);  // the loop thread ran
+  EXPECT_TRUE(run.stats.places.loops.empty());
+  EXPECT_EQ(run.stats.places.num_relocalizations, 0);
+}
+
+TEST(System, KidnappedCameraIsRelocalisedFromThePlaceDatabase) {
+  // The camera travels 80 frames, then is carried back to where it was at frame 10 and goes
+  // on from there. The reference-keyframe fallback is switched off (in this scene it would
+  // find the kidnapped camera by itself): every frame the motion model cannot track is lost
+  // and only the place database can give its pose back, in the same map frame and scale.
+  SyntheticFeatureScene scene(TestCamera());
+  SystemOptions options;
+  options.vocabulary = ShippedVocabulary();
+  options.tracker.min_reference_matches = 1000000;
+  System system(TestCamera(), options);
+  std::vector<int> truth;
+  int frame_index = 0;
+  auto feed = [&](int t) {
+    const FrameReport report = system.ProcessFrame(
+        scene.MakeFrame(FrameId(frame_index), 0.05 * frame_index, WorldFromCam(t).Inverse(), &truth));
+    ++frame_index;
+    return report;
+  };
+  for (int t = 0; t < 80; ++t) feed(t);
+  const int relocalisations_before = system.Stats().places.num_relocalizations;
+  int first_relocalised = -1;
+  int posed_after = 0;
+  for (int t = 10; t < 30; ++t) {
+    const FrameReport report = feed(t);
+    if (report.cam_from_world && first_relocalised < 0) first_relocalised = t;
+    if (report.cam_from_world) ++posed_after;
+  }
+  system.Finish();
+  const SystemStats stats = system.Stats();
+  EXPECT_EQ(first_relocalised, 10);  // the first frame after the kidnapping
+  EXPECT_EQ(posed_after, 20);
+  EXPECT_GT(stats.places.num_relocalizations, relocalisations_before);
+  EXPECT_EQ(stats.num_resets, 0);
+  // Every pose, before and after, against the truth after one Sim(3) alignment: the
+  // relocalised leg is in the same map frame and scale as the first one.
+  std::vector<Eigen::Vector3d> estimated, expected;
+  int after_kidnap = 0;
+  for (const StampedPose& pose : system.Trajectory()) {
+    const int index = static_cast<int>(std::lround(pose.timestamp_s / 0.05));
+    estimated.push_back(pose.world_from_cam.translation);
+    expected.push_back(WorldFromCam(index < 80 ? index : index - 70).translation);
+    if (index >= 80) ++after_kidnap;
+  }
+  EXPECT_EQ(after_kidnap, 20);
+  const std::optional<Sim3> aligned =
+      UmeyamaAlignment(estimated, expected, AlignmentKind::kSimilarity);
+  ASSERT_TRUE(aligned.has_value());
+  double worst = 0.0;
+  for (std::size_t i = 0; i < estimated.size(); ++i) {
+    worst = std::max(worst, ((*aligned) * estimated[i] - expected[i]).norm());
+  }
+  EXPECT_LT(worst, 0.05);  // the route is 2.4 m long
+  EXPECT_EQ(system.map().Read([](const MapData& data) { return data.CheckInvariants(); }), "");
 }
 
 TEST(System, StaticSyntheticCameraNeverInitialises) {

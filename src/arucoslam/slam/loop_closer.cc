@@ -1,5 +1,6 @@
 #include "arucoslam/slam/loop_closer.h"
 
+#include <cmath>
 #include <set>
 
 #include "arucoslam/feature/feature_grid.h"
@@ -22,6 +23,7 @@ struct KeyframeMatches {
   CameraModel current_camera;
   CameraModel candidate_camera;
   Rigid3 candidate_cam_from_world;
+  Rigid3 current_cam_from_world;
   std::vector<Sim3Correspondence> correspondences;
   std::vector<FuseAction> fusions;  // per correspondence: current keypoint -> candidate point
 };
@@ -36,6 +38,7 @@ KeyframeMatches MatchKeyframes(const MapData& data, KeyframeId current_id, Keyfr
   result.current_camera = current->camera;
   result.candidate_camera = candidate->camera;
   result.candidate_cam_from_world = candidate->cam_from_world;
+  result.current_cam_from_world = current->cam_from_world;
   for (const FeatureMatch& match :
        MatchBruteForce(current->features, candidate->features, options)) {
     const MapPointId current_point = current->map_point_ids[match.index1];
@@ -166,12 +169,18 @@ std::vector<LoopConstraint> LoopConnections(
 bool LoopCloserOptions::Check() const {
   return matching.Check() && sim3.Check() && loop_neighbours >= 0 && search_radius_px > 0.0 &&
          max_projection_distance > 0 && reprojection_chi2 > 0.0 && min_total_matches >= 3 &&
+         max_correction_rotation_deg > 0.0 &&
          correction_neighbours >= 0 && essential_graph.Check();
 }
 
 LoopCloser::LoopCloser(Map& map, const LoopCloserOptions& options) : map_(map), options_(options) {
-  options_.sim3.fix_scale = options_.metric_map;
-  options_.essential_graph.solver.fix_scale = options_.metric_map;
+  SetMetricMap(options_.metric_map);
+}
+
+void LoopCloser::SetMetricMap(bool metric) {
+  options_.metric_map = metric;
+  options_.sim3.fix_scale = metric;
+  options_.essential_graph.solver.fix_scale = metric;
 }
 
 LoopClosureResult LoopCloser::CloseLoop(KeyframeId current, KeyframeId candidate) {
@@ -198,6 +207,14 @@ LoopClosureResult LoopCloser::CloseLoop(KeyframeId current, KeyframeId candidate
   }
   const Sim3 current_corrected =
       solved.candidate_from_current.Inverse() * Sim3(matches.candidate_cam_from_world);
+  result.correction_rotation_deg =
+      RotationAngle(current_corrected.rotation.conjugate() *
+                    matches.current_cam_from_world.rotation) * 180.0 / M_PI;
+  if (result.correction_rotation_deg > options_.max_correction_rotation_deg) {
+    result.reason = "correction rotation " + std::to_string(result.correction_rotation_deg) +
+                    " deg";
+    return result;
+  }
   const std::map<KeyframeId, Sim3> corrected =
       PropagateLoopCorrection(map_, current, current_corrected, options_.correction_neighbours);
 

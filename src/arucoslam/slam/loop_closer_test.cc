@@ -109,6 +109,24 @@ TEST(LoopCloserTest, GlobalBundleAdjustmentAfterTheLoopLowersTheError) {
   EXPECT_EQ(scene.map.Read([](const MapData& data) { return data.CheckInvariants(); }), "");
 }
 
+TEST(LoopCloserTest, RejectsALoopThatTurnsTheMapMoreThanDriftCan) {
+  // The synthetic loop drifts 0.01 rad per keyframe: 39 steps ask for a 22.3 degree turn,
+  // accepted under a 30 degree bound and refused by a 15 degree one (as a look-alike place
+  // seen from elsewhere would be).
+  for (const double max_deg : {30.0, 15.0}) {
+    WallLoop scene;
+    Build(scene);
+    const std::uint64_t version = scene.map.Version();
+    LoopCloserOptions options;
+    options.max_correction_rotation_deg = max_deg;
+    LoopCloser closer(scene.map, options);
+    const LoopClosureResult result = closer.CloseLoop(scene.keyframes.back(), scene.keyframes[0]);
+    EXPECT_NEAR(result.correction_rotation_deg, 39 * 0.01 * 180.0 / M_PI, 1.0);
+    EXPECT_EQ(result.closed, max_deg == 30.0) << result.reason;
+    if (!result.closed) EXPECT_EQ(scene.map.Version(), version);  // nothing written
+  }
+}
+
 TEST(LoopCloserTest, RejectsKeyframesThatDoNotOverlap) {
   WallLoop scene;
   Build(scene);

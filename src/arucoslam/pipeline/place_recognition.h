@@ -1,0 +1,131 @@
+// PlaceRecognition: the bag-of-words side of a running System for one map: the keyframe
+// database, relocalisation of lost frames, loop detection and closing, and global BA.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <vector>
+
+#include "arucoslam/feature/vocabulary.h"
+#include "arucoslam/map/map.h"
+#include "arucoslam/optim/global_bundle_adjustment.h"
+#include "arucoslam/pipeline/bounded_queue.h"
+#include "arucoslam/slam/keyframe_database.h"
+#include "arucoslam/slam/loop_closer.h"
+#include "arucoslam/slam/loop_detector.h"
+#include "arucoslam/slam/relocalizer.h"
+#include "arucoslam/util/timing.h"
+
+namespace arucoslam {
+
+struct PlaceRecognitionOptions {
+  bool loop_closing = true;  // false: database and relocalisation only
+  KeyframeDatabaseOptions database;
+  RelocalizerOptions relocalizer;
+  LoopDetectorOptions detector;
+  LoopCloserOptions closer;
+  // After each closed loop: a global bundle adjustment (on its own thread unless blocking).
+  bool global_bundle_adjustment = true;
+  GlobalBundleAdjustmentOptions global_ba;
+  int loop_queue_capacity = 64;  // mapped keyframes waiting for the loop-closing thread
+
+  bool Check() const;
+};
+
+// One closed loop, for logs and for checking it against ground truth.
+struct ClosedLoop {
+  double current_timestamp_s = 0.0;    // the new keyframe
+  double candidate_timestamp_s = 0.0;  // the old keyframe it was matched to
+  Sim3 candidate_from_current;         // as solved, in map units before the correction
+  int num_inliers = 0;                 // Sim3 inliers plus projected matches
+  double detection_to_corrected_ms = 0.0;
+};
+
+struct PlaceRecognitionStats {
+  int num_relocalizations = 0;         // lost frames relocalised from the database
+  int num_relocalization_attempts = 0;
+  TimingStats relocalization_ms;       // per attempt
+  TimingStats loop_detection_ms;       // per mapped keyframe: database + detection
+  int num_loop_candidates = 0;         // consistent candidates verified
+  int num_loops_rejected = 0;          // candidates LoopCloser refused
+  std::vector<ClosedLoop> loops;       // closed loops, in order
+  TimingStats loop_correction_ms;      // detection -> corrected map, per closed loop
+  int num_global_bundle_adjustments = 0;  // applied to the map
+  int num_global_bundle_adjustments_discarded = 0;  // the map was changed under them
+  TimingStats global_bundle_adjustment_ms;          // snapshot to applied, per run
+};
+
+// Thread safety: Relocalize runs on the tracking thread, KeyframeMapped on the mapping thread;
+// the database has its own lock. Map edits by local mapping and by loop closing are serialised
+// with LockMapEdits (local mapping waits while a loop is being closed).
+class PlaceRecognition {
+ public:
+  // `threaded`: loop closing and global BA run on their own threads; otherwise inline in
+  // KeyframeMapped. Statistics are added to `stats` under `stats_mutex`.
+  PlaceRecognition(Map& map, std::shared_ptr<const Vocabulary> vocabulary,
+                   const PlaceRecognitionOptions& options, bool threaded,
+                   PlaceRecognitionStats* stats, std::mutex* stats_mutex);
+  ~PlaceRecognition();
+  PlaceRecognition(const PlaceRecognition&) = delete;
+  PlaceRecognition& operator=(const PlaceRecognition&) = delete;
+
+  // Pose of a lost frame from the database (frame features undistorted); nullopt when none.
+  std::optional<RelocalizationResult> Relocalize(const Frame& frame);
+  // Every keyframe already in the map enters the database (a map loaded from a file).
+  void IndexExistingKeyframes();
+  // A keyframe finished local mapping: it enters the database and the loop detector.
+  void KeyframeMapped(KeyframeId keyframe);
+  // Held by local mapping for each keyframe, and by loop closing and world alignment.
+  std::unique_lock<std::mutex> LockMapEdits() { return std::unique_lock(edit_mutex_); }
+  // The map was moved from outside (world alignment) while holding LockMapEdits: a running
+  // global BA is discarded.
+  void MapMovedExternally();
+  // The loop closer keeps the monocular scale fixed once the map is metric (markers).
+  void SetMetricMap(bool metric);
+  // Incremented by each closed loop and applied global BA: the tracking thread re-anchors
+  // its last pose to its reference keyframe when this changes.
+  std::uint64_t corrections() const { return corrections_; }
+  // Waits for queued keyframes and a running global BA; idempotent.
+  void Finish();
+
+ private:
+  void AddToDatabase(KeyframeId keyframe);
+  void DetectAndClose(KeyframeId keyframe);
+  void RequestGlobalBundleAdjustment();
+  void RunGlobalBundleAdjustmentOnce();
+  void GlobalBundleAdjustmentLoop();
+
+  Map& map_;
+  std::shared_ptr<const Vocabulary> vocabulary_;
+  PlaceRecognitionOptions options_;
+  bool threaded_;
+  PlaceRecognitionStats* stats_;
+  std::mutex* stats_mutex_;
+
+  mutable std::mutex database_mutex_;
+  KeyframeDatabase database_;
+  std::vector<KeyframeId> stored_;  // keyframes in the database (culled ones are erased)
+  Relocalizer relocalizer_;
+  LoopDetector detector_;
+  LoopCloser closer_;
+
+  std::mutex edit_mutex_;
+  std::uint64_t epoch_ = 0;  // under edit_mutex_: bumped by every change a global BA cannot merge
+  std::atomic<std::uint64_t> corrections_{0};
+
+  std::unique_ptr<BoundedQueue<KeyframeId>> queue_;
+  std::thread loop_thread_;
+  std::mutex ba_mutex_;
+  std::condition_variable ba_wake_;
+  bool ba_requested_ = false;
+  bool ba_stop_ = false;
+  std::thread ba_thread_;
+  bool finished_ = false;
+};
+
+}  // namespace arucoslam

@@ -1,0 +1,94 @@
+// System's place recognition: one PlaceRecognition per map (keyframe database, loop
+// closing, global BA), relocalisation of lost frames, and following loop corrections.
+#include <iterator>
+
+#include "arucoslam/pipeline/system.h"
+#include "arucoslam/util/logging.h"
+
+namespace arucoslam {
+
+void System::MakePlaceRecognition() {
+  places_.reset();
+  seen_corrections_ = 0;
+  keyframe_poses_.clear();
+  if (!options_.vocabulary) return;
+  places_ = std::make_unique<PlaceRecognition>(*map_, options_.vocabulary, options_.places,
+                                               !options_.blocking, &stats_.places, &stats_mutex_);
+}
+
+bool System::RelocalizeWithPlaces(Frame& frame, FrameReport& report) {
+  if (!places_) return false;
+  const std::optional<RelocalizationResult> found = places_->Relocalize(frame);
+  if (!found) return false;
+  // The database pose is refined against the local map as after a marker relocalisation.
+  const TrackingResult result = tracker_->TrackFromPose(frame, found->cam_from_world);
+  if (result.state != TrackingState::kTracking) return false;
+  tracker_->SetReferenceKeyframe(found->keyframe);
+  report.num_inliers = result.num_inliers;
+  report.message = "relocalised from the place database";
+  ARUCOSLAM_LOG_DEBUG("frame {}: relocalised from keyframe {}, {} inliers", report.index,
+                      found->keyframe.value, result.num_inliers);
+  std::lock_guard lock(stats_mutex_);
+  ++stats_.places.num_relocalizations;
+  return true;
+}
+
+void System::ReanchorOrphanPoses() {
+  std::map<KeyframeId, Rigid3> now;
+  map_->Read([&](const MapData& data) {
+    for (const auto& [id, keyframe] : data.keyframes()) now.emplace(id, keyframe.cam_from_world);
+    return 0;
+  });
+  std::map<double, KeyframeId> by_time;
+  for (TrackedPose& pose : poses_) {
+    if (!pose.reference.IsValid() || now.count(pose.reference) != 0) continue;
+    const auto last = keyframe_poses_.find(pose.reference);
+    if (last == keyframe_poses_.end() || now.empty()) continue;
+    if (by_time.empty()) {
+      map_->Read([&](const MapData& data) {
+        for (const auto& [id, keyframe] : data.keyframes()) by_time.emplace(keyframe.timestamp_s, id);
+        return 0;
+      });
+    }
+    auto nearest = by_time.lower_bound(pose.timestamp_s);
+    if (nearest == by_time.end() ||
+        (nearest != by_time.begin() &&
+         pose.timestamp_s - std::prev(nearest)->first < nearest->first - pose.timestamp_s)) {
+      nearest = std::prev(nearest);
+    }
+    const KeyframeId anchor = nearest->second;
+    if (now.count(anchor) == 0) continue;
+    pose.cam_from_world = pose.cam_from_reference * last->second;
+    pose.reference = anchor;
+    pose.cam_from_reference = pose.cam_from_world * now.at(anchor).Inverse();
+  }
+  keyframe_poses_ = std::move(now);
+}
+
+void System::FollowMapCorrections() {
+  if (!places_) return;
+  ReanchorOrphanPoses();
+  if (places_->corrections() == seen_corrections_) return;
+  seen_corrections_ = places_->corrections();
+  if (tracker_->state() != TrackingState::kTracking || poses_.empty()) return;
+  const TrackedPose& last = poses_.back();
+  const std::optional<Rigid3> reference = map_->Read([&](const MapData& data) {
+    const Keyframe* keyframe = data.FindKeyframe(last.reference);
+    return keyframe ? std::optional<Rigid3>(keyframe->cam_from_world) : std::nullopt;
+  });
+  if (!reference) return;
+  // world_now_from_world_then, rigid: the camera keeps its pose relative to its reference.
+  const Rigid3 cam_from_world_now = last.cam_from_reference * *reference;
+  tracker_->ApplySimilarity(Sim3(cam_from_world_now.Inverse() * last.cam_from_world));
+}
+
+std::unique_lock<std::mutex> System::LockPlacesForMapMove() {
+  if (!places_) return {};
+  std::unique_lock<std::mutex> lock = places_->LockMapEdits();
+  places_->MapMovedExternally();
+  // The only outside move is the alignment to the marker world, which makes the map metric.
+  places_->SetMetricMap(true);
+  return lock;
+}
+
+}  // namespace arucoslam
