@@ -68,6 +68,9 @@ int RunSlam(const RunArgs& args) {
   SystemOptions options;
   options.blocking = args.blocking;
   options.extractor.num_features = args.num_features;
+  // Low-contrast cells: 5 grey levels (extractor default 7) keeps keypoints on the faint marks
+  // of plain walls; the medium-texture route's U-turn facing one stays tracked.
+  options.extractor.min_fast_threshold = 5;
   const std::optional<std::filesystem::path> markers_path = dataset.markers_path();
   if (markers_path && !args.no_markers) {
     options.marker_map = ReadMarkerMapJson(*markers_path);

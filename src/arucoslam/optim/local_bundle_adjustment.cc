@@ -17,18 +17,29 @@ struct Snapshot {
   int num_fixed = 0;
 };
 
+// Every border keyframe is fixed; `border` maps each to the number of window points it
+// observes. Window keyframes are added (oldest first) until min_fixed_keyframes fixed ones
+// are anchors (see min_anchor_points); the map's first keyframe always is one.
 std::set<KeyframeId> ChooseFixed(const MapData& data, KeyframeId current,
                                  const std::vector<KeyframeId>& local,
-                                 const std::set<KeyframeId>& border,
+                                 const std::map<KeyframeId, int>& border,
                                  const LocalBundleAdjustmentOptions& options) {
-  std::set<KeyframeId> fixed = border;
-  std::set<KeyframeId> local_sorted(local.begin(), local.end());
-  if (local_sorted.count(data.FirstKeyframe()) != 0) fixed.insert(data.FirstKeyframe());
-  for (const KeyframeId& id : local_sorted) {
-    if (static_cast<int>(fixed.size()) >= options.min_fixed_keyframes) break;
-    if (id != current) fixed.insert(id);
+  std::set<KeyframeId> fixed;
+  int anchors = 0;
+  for (const auto& [id, shared] : border) {
+    fixed.insert(id);
+    if (shared >= options.min_anchor_points) ++anchors;
   }
-  if (static_cast<int>(fixed.size()) < options.min_fixed_keyframes) fixed.insert(current);
+  std::set<KeyframeId> local_sorted(local.begin(), local.end());
+  if (local_sorted.count(data.FirstKeyframe()) != 0) {
+    fixed.insert(data.FirstKeyframe());
+    ++anchors;
+  }
+  for (const KeyframeId& id : local_sorted) {
+    if (anchors >= options.min_fixed_keyframes) break;
+    if (id != current && fixed.insert(id).second) ++anchors;
+  }
+  if (anchors < options.min_fixed_keyframes) fixed.insert(current);
   return fixed;
 }
 
@@ -47,13 +58,15 @@ Snapshot TakeSnapshot(const MapData& data, KeyframeId current,
     for (const MapPointId& point : data.MapPointsOf(id)) points.insert(point);
   }
   const std::set<KeyframeId> local_set(local.begin(), local.end());
-  std::set<KeyframeId> border;
+  std::map<KeyframeId, int> border_points;  // border keyframe -> window points it observes
   for (const MapPointId& point : points) {
     for (const auto& [observer, index] : data.FindMapPoint(point)->observations) {
-      if (local_set.count(observer) == 0) border.insert(observer);
+      if (local_set.count(observer) == 0) ++border_points[observer];
     }
   }
-  const std::set<KeyframeId> fixed = ChooseFixed(data, current, local, border, options);
+  std::set<KeyframeId> border;
+  for (const auto& [id, count] : border_points) border.insert(id);
+  const std::set<KeyframeId> fixed = ChooseFixed(data, current, local, border_points, options);
 
   snapshot.problem.intrinsics = PinholeIntrinsics::FromCamera(keyframe->camera);
   std::map<KeyframeId, std::size_t> pose_index;
@@ -69,7 +82,8 @@ Snapshot TakeSnapshot(const MapData& data, KeyframeId current,
   for (const MapPointId& point_id : points) {
     const MapPoint* point = data.FindMapPoint(point_id);
     const std::size_t point_index = snapshot.problem.points.size();
-    snapshot.problem.points.push_back({point->p_in_world, false});
+    // One view cannot place a point (its depth is free): it is held, constraining the pose.
+    snapshot.problem.points.push_back({point->p_in_world, point->observations.size() < 2});
     snapshot.point_ids.push_back(point_id);
     for (const auto& [observer, index] : point->observations) {
       const Keyframe* observer_keyframe = data.FindKeyframe(observer);

@@ -12,15 +12,20 @@ struct LocalBundleAdjustmentOptions {
   // Local window: the keyframe and up to this many of its best covisible keyframes.
   int max_covisible_keyframes = 20;
   // Keyframes outside the window that observe its points are held fixed. When fewer than
-  // this many are fixed, the lowest-id keyframes of the window are fixed too (the current
-  // keyframe last). The map's first keyframe is always fixed.
+  // this many fixed keyframes are anchors, the lowest-id keyframes of the window are fixed
+  // too (the current keyframe last). The map's first keyframe is always fixed.
   int min_fixed_keyframes = 1;
+  // A fixed border keyframe is an anchor (holds the gauge: position, rotation, and scale
+  // with two) only when it observes at least this many window points. Border keyframes
+  // seeing two or three points left the gauge nearly free and Ceres' Cholesky failed.
+  int min_anchor_points = 20;
   // Erase observations the solve flags as outliers (chi-square test); points left with no
   // observation are erased.
   bool erase_outliers = true;
 
   bool Check() const {
-    return solver.Check() && max_covisible_keyframes >= 0 && min_fixed_keyframes >= 0;
+    return solver.Check() && max_covisible_keyframes >= 0 && min_fixed_keyframes >= 0 &&
+           min_anchor_points >= 0;
   }
 };
 

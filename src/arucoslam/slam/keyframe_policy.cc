@@ -5,7 +5,8 @@ namespace arucoslam {
 bool KeyframePolicyOptions::Check() const {
   return min_frames_between >= 0 && max_frames_between >= min_frames_between &&
          tracked_ratio > 0.0 && tracked_ratio <= 1.0 && min_observations >= 1 &&
-         min_tracked_points >= 0;
+         min_tracked_points >= 0 && weak_ratio >= 0.0 && weak_ratio <= tracked_ratio &&
+         weak_tracked_points >= 0;
 }
 
 KeyframeDecision DecideKeyframe(const KeyframePolicyOptions& options,
@@ -17,6 +18,11 @@ KeyframeDecision DecideKeyframe(const KeyframePolicyOptions& options,
   const bool waited_long = input.frames_since_last_keyframe >= options.max_frames_between;
   const bool may_when_idle = input.frames_since_last_keyframe >= options.min_frames_between;
   if (input.mapper_idle && may_when_idle) return {true, "ratio"};
+  const bool weak = input.num_tracked < options.weak_ratio * input.num_reference_tracked ||
+                    input.num_tracked < options.weak_tracked_points;
+  if (weak && input.frames_since_last_keyframe >= 1 && input.mapper_has_room) {
+    return {true, "weak"};
+  }
   if (waited_long && input.mapper_has_room) return {true, "max-frames"};
   return {false, input.mapper_idle ? "too-soon" : "busy"};
 }

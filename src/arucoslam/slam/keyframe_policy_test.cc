@@ -48,6 +48,28 @@ TEST(KeyframePolicy, BusyMapperDefersUntilMaxFramesAndQueueRoom) {
   EXPECT_FALSE(DecideKeyframe(options, Input(40, 195, 200, true)).insert);
 }
 
+TEST(KeyframePolicy, WeakTrackingInsertsWithoutWaiting) {
+  KeyframePolicyOptions options;
+  options.min_frames_between = 4;
+  options.weak_ratio = 0.5;
+  options.weak_tracked_points = 100;
+  // Normal ratio drop: waits for min_frames_between.
+  EXPECT_EQ(DecideKeyframe(options, Input(1, 150, 200, true)).reason, "too-soon");
+  EXPECT_EQ(DecideKeyframe(options, Input(4, 150, 200, true)).reason, "ratio");
+  // Below half the reference's points, or below 100 inliers: the next frame already.
+  EXPECT_EQ(DecideKeyframe(options, Input(1, 99, 400, true)).reason, "weak");
+  EXPECT_EQ(DecideKeyframe(options, Input(1, 120, 260, true)).reason, "weak");
+  EXPECT_EQ(DecideKeyframe(options, Input(1, 130, 260, true)).reason, "too-soon");
+  // Also with a busy mapper, but only when its queue has room.
+  EXPECT_EQ(DecideKeyframe(options, Input(1, 99, 400, false)).reason, "weak");
+  EXPECT_EQ(DecideKeyframe(options, Input(1, 99, 400, false, false)).reason, "busy");
+  // Never the keyframe's own frame, and never with too few inliers.
+  EXPECT_EQ(DecideKeyframe(options, Input(0, 99, 400, true)).reason, "too-soon");
+  EXPECT_EQ(DecideKeyframe(options, Input(3, 15, 400, true)).reason, "too-few");
+  options.weak_ratio = 0.95;  // above tracked_ratio
+  EXPECT_FALSE(options.Check());
+}
+
 TEST(KeyframePolicy, InsertKeyframeLinksCovisibilityAndSpanningTree) {
   Map map;
   CameraModel camera;

@@ -8,9 +8,20 @@
 
 #include "arucoslam/feature/feature_grid.h"
 #include "arucoslam/slam/projection_queries.h"
+#include "arucoslam/util/logging.h"
 
 namespace arucoslam {
-namespace {}  // namespace
+namespace {
+
+void LogResult(const Frame& frame, const TrackingResult& result) {
+  ARUCOSLAM_LOG_DEBUG("frame {}: {} {} matches {} inliers, +{} local, {} final -> {}",
+                      frame.id.value, result.method.empty() ? "-" : result.method,
+                      result.num_initial_matches, result.num_initial_inliers,
+                      result.num_local_map_matches, result.num_inliers,
+                      TrackingStateName(result.state));
+}
+
+}  // namespace
 
 std::string TrackingStateName(TrackingState state) {
   switch (state) {
@@ -28,23 +39,26 @@ bool TrackerOptions::Check() const {
   return motion_search.Check() && min_motion_matches >= 0 && reference_search.Check() &&
          min_reference_matches >= 0 && covisible_per_keyframe >= 0 && max_local_keyframes >= 1 &&
          local_map_search.Check() && min_view_cos >= -1.0 && min_view_cos <= 1.0 &&
-         min_pose_inliers >= 3 && min_local_map_inliers >= min_pose_inliers && pose.Check() &&
+         recovery_frames >= 0 && min_pose_inliers >= 3 && min_local_map_inliers >= min_pose_inliers && pose.Check() &&
          marker_pose.Check() && relocalization_min_axis_cos >= -1.0 &&
          relocalization_min_axis_cos <= 1.0;
 }
 
-Tracker::Tracker(Map& map, const TrackerOptions& options) : map_(map), options_(options) {}
+Tracker::Tracker(Map& map, const TrackerOptions& options) : map_(map), options_(options) {
+}
 
 void Tracker::Start(const Frame& frame, KeyframeId reference) {
   last_frame_ = frame;
   reference_keyframe_ = reference;
   velocity_.reset();
+  frames_lost_ = 0;
   state_ = TrackingState::kTracking;
 }
 
 void Tracker::Reset() {
   last_frame_.reset();
   velocity_.reset();
+  frames_lost_ = 0;
   reference_keyframe_ = KeyframeId();
   state_ = TrackingState::kNotInitialized;
 }
@@ -61,7 +75,7 @@ TrackingResult Tracker::Track(Frame& frame, const std::vector<MarkerPoseObservat
   frame.ResetMatches();
   frame.cam_from_world.reset();
   bool ok = false;
-  if (velocity_ && state_ == TrackingState::kTracking) ok = TrackWithMotionModel(frame, result);
+  if (velocity_) ok = TrackWithMotionModel(frame, result, frames_lost_ + 1);
   if (!ok) {
     frame.ResetMatches();
     ok = TrackReferenceKeyframe(frame, result);
@@ -69,21 +83,26 @@ TrackingResult Tracker::Track(Frame& frame, const std::vector<MarkerPoseObservat
   if (ok) ok = TrackLocalMap(frame, result);
   if (!ok) {
     frame.cam_from_world.reset();
-    velocity_.reset();
+    if (++frames_lost_ > options_.recovery_frames) velocity_.reset();
     state_ = TrackingState::kLost;
     result.state = state_;
+    LogResult(frame, result);
     result.method.clear();
     return result;
   }
   velocity_ = *frame.cam_from_world * last_frame_->cam_from_world->Inverse();
+  if (frames_lost_ > 0) velocity_ = Rigid3::Exp(velocity_->Log() / (frames_lost_ + 1));
+  frames_lost_ = 0;
   last_frame_ = frame;
   state_ = TrackingState::kTracking;
   result.state = state_;
+  LogResult(frame, result);
   return result;
 }
 
-bool Tracker::TrackWithMotionModel(Frame& frame, TrackingResult& result) {
-  const Rigid3 predicted = *velocity_ * *last_frame_->cam_from_world;
+bool Tracker::TrackWithMotionModel(Frame& frame, TrackingResult& result, int steps) {
+  Rigid3 predicted = *last_frame_->cam_from_world;
+  for (int k = 0; k < steps; ++k) predicted = *velocity_ * predicted;
   ProjectionQueries set;
   map_.Read([&](const MapData& data) {
     for (std::size_t i = 0; i < last_frame_->map_point_ids.size(); ++i) {
@@ -98,12 +117,13 @@ bool Tracker::TrackWithMotionModel(Frame& frame, TrackingResult& result) {
   });
   set.Finalize();
   const FeatureGrid grid(frame.features);
+  ProjectionMatchOptions search = options_.motion_search;
+  if (steps > 1) search.base_radius_px *= 2.0;  // recovering: the prediction is older
   std::vector<FeatureMatch> matches =
-      MatchByProjection(frame.features, grid, set.queries, {}, options_.motion_search);
+      MatchByProjection(frame.features, grid, set.queries, {}, search);
   if (static_cast<int>(matches.size()) < options_.min_motion_matches) {
-    ProjectionMatchOptions wide = options_.motion_search;
-    wide.base_radius_px *= 2.0;
-    matches = MatchByProjection(frame.features, grid, set.queries, {}, wide);
+    search.base_radius_px *= 2.0;
+    matches = MatchByProjection(frame.features, grid, set.queries, {}, search);
   }
   result.num_initial_matches = static_cast<int>(matches.size());
   if (result.num_initial_matches < options_.min_motion_matches) return false;
@@ -181,6 +201,7 @@ TrackingResult Tracker::TrackFromPose(Frame& frame, const Rigid3& cam_from_world
   }
   last_frame_ = frame;
   velocity_.reset();
+  frames_lost_ = 0;
   state_ = TrackingState::kTracking;
   result.state = state_;
   return result;

@@ -24,6 +24,10 @@ struct TrackerOptions {
   ProjectionMatchOptions motion_search{15.0, 1, 100, 0.9, true, {}};
   // Fewer matches than this: search again with twice the radius, then fall back.
   int min_motion_matches = 20;
+  // After a loss the motion model keeps predicting (constant velocity from the last tracked
+  // frame, search radius doubled) for this many frames, so that a short bland stretch (a
+  // turn facing a plain wall) does not end tracking for good. 0: no such retry.
+  int recovery_frames = 15;
   // Fallback: brute-force descriptor matching against the reference keyframe.
   BruteForceMatchOptions reference_search{64, 0.75, true, true, {}};
   int min_reference_matches = 15;
@@ -92,7 +96,8 @@ class Tracker {
   const std::optional<Rigid3>& velocity() const { return velocity_; }
 
  private:
-  bool TrackWithMotionModel(Frame& frame, TrackingResult& result);
+  // `steps`: frames since the last tracked one (1 while tracking).
+  bool TrackWithMotionModel(Frame& frame, TrackingResult& result, int steps);
   bool TrackReferenceKeyframe(Frame& frame, TrackingResult& result);
   bool TrackLocalMap(Frame& frame, TrackingResult& result);
   // Pose-only optimisation over the frame's matches from `initial`; drops outlier matches
@@ -106,6 +111,7 @@ class Tracker {
   TrackingState state_ = TrackingState::kNotInitialized;
   std::optional<Frame> last_frame_;
   std::optional<Rigid3> velocity_;
+  int frames_lost_ = 0;  // frames since the last tracked one, while lost
   KeyframeId reference_keyframe_;
   const std::vector<MarkerPoseObservation>* markers_ = nullptr;  // during Track only
 };

@@ -199,27 +199,45 @@ TEST(TrackerTest, TracksASequenceToTheTruth) {
   EXPECT_GT(found_ratio, 0.5);
 }
 
-TEST(TrackerTest, LostOnAnUnrelatedFrameThenRecoversFromTheReference) {
+// One unrelated frame (a bland view) loses tracking; with recovery_frames the motion model
+// keeps predicting and picks the next frame up, without it the reference keyframe does.
+void LoseOneFrameAndRecover(int recovery_frames, const std::string& expected_method) {
+  SCOPED_TRACE("recovery_frames " + std::to_string(recovery_frames));
   SyntheticWorld world(3);
   Map map;
   Frame start;
   const KeyframeId reference = BuildInitialMap(world, map, &start);
-  Tracker tracker(map);
+  TrackerOptions options;
+  options.recovery_frames = recovery_frames;
+  Tracker tracker(map, options);
   tracker.Start(start, reference);
   std::vector<int> truth;
-  Frame frame = world.MakeFrame(6, &truth);
-  ASSERT_EQ(tracker.Track(frame).state, TrackingState::kTracking);
-  Frame unrelated = world.MakeFrame(7, &truth, true);
+  for (int t = 6; t <= 7; ++t) {
+    Frame frame = world.MakeFrame(t, &truth);
+    ASSERT_EQ(tracker.Track(frame).state, TrackingState::kTracking);
+  }
+  Frame unrelated = world.MakeFrame(8, &truth, true);
   const TrackingResult lost = tracker.Track(unrelated);
   EXPECT_EQ(lost.state, TrackingState::kLost);
   EXPECT_FALSE(unrelated.cam_from_world.has_value());
-  EXPECT_FALSE(tracker.velocity().has_value());
-  Frame again = world.MakeFrame(8, &truth);
+  EXPECT_EQ(tracker.velocity().has_value(), recovery_frames > 0);
+  Frame again = world.MakeFrame(9, &truth);
   const TrackingResult recovered = tracker.Track(again);
   EXPECT_EQ(recovered.state, TrackingState::kTracking);
-  EXPECT_EQ(recovered.method, "reference");
+  EXPECT_EQ(recovered.method, expected_method);
   ASSERT_TRUE(again.cam_from_world.has_value());
-  EXPECT_LT(PositionError(*again.cam_from_world, world.CamFromWorld(8)), 0.005);
+  EXPECT_LT(PositionError(*again.cam_from_world, world.CamFromWorld(9)), 0.005);
+  // The velocity is one frame's motion again, not the two frames since the last pose.
+  ASSERT_TRUE(tracker.velocity().has_value());
+  const Rigid3 expected = world.CamFromWorld(9) * world.CamFromWorld(8).Inverse();
+  if (recovery_frames > 0) {
+    EXPECT_LT((tracker.velocity()->translation - expected.translation).norm(), 0.005);
+  }
+}
+
+TEST(TrackerTest, LostOnAnUnrelatedFrameThenRecovers) {
+  LoseOneFrameAndRecover(15, "motion");
+  LoseOneFrameAndRecover(0, "reference");
 }
 
 }  // namespace
