@@ -54,6 +54,7 @@ void System::Finish() {
   if (finished_) return;
   finished_ = true;
   StopMappingThread();
+  FinishMarkerMapping();
 }
 
 bool System::MapperIdle() const {
@@ -63,6 +64,7 @@ bool System::MapperIdle() const {
 
 void System::MapKeyframe(KeyframeId keyframe) {
   const Stopwatch watch;
+  FeedMarkerMapping(keyframe);
   const LocalMappingResult r = mapper_->ProcessKeyframe(keyframe);
   const double elapsed = watch.ElapsedMilliseconds();
   ARUCOSLAM_LOG_DEBUG(
@@ -299,6 +301,7 @@ void System::ResetMap() {
   map_ = std::make_unique<Map>();
   tracker_ = std::make_unique<Tracker>(*map_, options_.tracker);
   mapper_ = std::make_unique<LocalMapper>(*map_, options_.mapper);
+  ResetMarkerMapping();
   poses_ = std::move(kept);
   init_reference_.reset();
   init_reference_fix_.reset();

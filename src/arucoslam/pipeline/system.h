@@ -24,6 +24,7 @@
 #include "arucoslam/slam/keyframe_policy.h"
 #include "arucoslam/slam/local_mapper.h"
 #include "arucoslam/slam/map_initialization.h"
+#include "arucoslam/slam/marker_mapper.h"
 #include "arucoslam/slam/tracker.h"
 #include "arucoslam/slam/world_alignment.h"
 #include "arucoslam/util/timing.h"
@@ -75,6 +76,14 @@ struct SystemOptions {
   // the map does not take them back: the map is discarded and a new one initialised and
   // aligned (the poses already output are kept).
   int marker_reset_lost_frames = 10;
+  // Once the map is world-aligned, keyframes' marker observations join local BA (known
+  // markers fixed) and markers the map lacks are mapped (system_marker_mapping.cc).
+  bool markers_in_local_ba = true;
+  bool map_unknown_markers = true;
+  // Finish runs one bundle adjustment of the whole aligned map with every marker
+  // observation (known markers fixed); otherwise only the mapped markers are refined.
+  bool final_marker_bundle_adjustment = true;
+  MarkerMapperOptions marker_mapping;
 
   bool Check() const;
 };
@@ -145,6 +154,9 @@ class System {
   const Map& map() const { return *map_; }
   TrackingState state() const { return tracker_ ? tracker_->state() : TrackingState::kNotInitialized; }
   bool world_aligned() const { return world_aligned_; }
+  // The known markers (fixed as in markers.json) and the ones mapped online (fixed: false).
+  // Call after Finish. Empty without a marker map.
+  MarkerMap MarkerMapOutput() const;
   // Copy of the statistics (the mapping thread adds to local_mapping_ms).
   SystemStats Stats() const;
 
@@ -168,7 +180,7 @@ class System {
   void Initialize(Frame& frame, FrameReport& report);
   void Track(Frame& frame, FrameReport& report);
   // Marker handling (system_markers.cc).
-  std::optional<MarkerFix> LocateWithMarkers(const Frame& frame,
+  std::optional<MarkerFix> LocateWithMarkers(Frame& frame,
                                              const std::vector<MarkerDetection>& detections,
                                              FrameReport& report);
   bool RelocalizeWithMarkers(Frame& frame, FrameReport& report);
@@ -177,6 +189,13 @@ class System {
   // pose in the map) is carried along.
   void MaybeAlignWorld(Frame* frame);
   void RecordMarkerPose(const Frame& frame, FrameReport& report);
+  // Marker mapping (system_marker_mapping.cc). Start: on each world alignment, with the
+  // mapping thread stopped. Feed: a keyframe's markers, before its local mapping. Reset:
+  // after the map was replaced. Finish: final marker refinement.
+  void StartMarkerMapping();
+  void FeedMarkerMapping(KeyframeId keyframe);
+  void ResetMarkerMapping();
+  void FinishMarkerMapping();
   void MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& report);
   void MapKeyframe(KeyframeId keyframe);
   void RecordPose(const Frame& frame, KeyframeId reference);
@@ -207,6 +226,9 @@ class System {
   int next_alignment_anchors_ = 0;  // alignment is tried again at this many anchors
   int lost_with_markers_ = 0;
   double detection_ms_ = 0.0;  // marker detection time of the current image
+  // Markers of the world-aligned map; only the mapping thread touches it while it runs.
+  std::unique_ptr<MarkerMapper> marker_mapper_;
+  bool marker_mapping_live_ = false;  // the current map is aligned and feeds marker_mapper_
 
   std::unique_ptr<BoundedQueue<KeyframeId>> queue_;
   std::thread mapping_thread_;
