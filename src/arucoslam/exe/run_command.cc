@@ -1,5 +1,6 @@
 // `arucoslam run`: monocular SLAM over a sequence (EuRoC layout, TUM RGB-D folder or image
-// folder) -> trajectory.tum, keyframes.tum, map.ply and stats.json in one output folder.
+// folder) -> trajectory.tum, keyframes.tum, map.ply, stats.json (and with markers
+// markers.json: the known markers and the ones mapped online) in one output folder.
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -19,6 +20,8 @@ struct RunArgs {
   std::string dataset;
   std::string out;
   std::string camera;
+  std::string markers;  // overrides the sequence's markers.json
+  double marker_size_m = 0.0;
   bool no_markers = false;
   bool blocking = false;
   bool quiet = false;
@@ -31,6 +34,9 @@ int RunSlam(const RunArgs& args) {
     throw InputError("--features", "expected at least 100, got " + std::to_string(args.num_features));
   }
   if (args.rate_hz < 0.0) throw InputError("--rate", "expected a rate >= 0 Hz");
+  if (!(args.marker_size_m >= 0.0)) {
+    throw InputError("--marker-size", "expected a side >= 0 m, got " + std::to_string(args.marker_size_m));
+  }
   DatasetOptions dataset_options;
   dataset_options.camera_path = args.camera;
   dataset_options.rate_hz = args.rate_hz;
@@ -41,10 +47,12 @@ int RunSlam(const RunArgs& args) {
   SystemOptions options;
   options.blocking = args.blocking;
   options.extractor.num_features = args.num_features;
-  const std::optional<std::filesystem::path> markers_path = dataset.markers_path();
+  std::optional<std::filesystem::path> markers_path = dataset.markers_path();
+  if (!args.markers.empty()) markers_path = args.markers;
   if (markers_path && !args.no_markers) {
     options.marker_map = ReadMarkerMapJson(*markers_path);
     options.detector.dictionary = options.marker_map->dictionary;
+    options.marker_mapping.unknown_marker_size_m = args.marker_size_m;
   }
   const bool markers = options.marker_map.has_value();
   const SlamRunResult result =
@@ -58,7 +66,8 @@ int RunSlam(const RunArgs& args) {
 void AddRunCommand(CLI::App& app, int& exit_status) {
   auto args = std::make_shared<RunArgs>();
   CLI::App* run = app.add_subcommand(
-      "run", "SLAM on a sequence -> trajectory.tum, keyframes.tum, map.ply, stats.json");
+      "run", "SLAM on a sequence -> trajectory.tum, keyframes.tum, map.ply, stats.json "
+             "(+ markers.json with a marker map)");
   run->add_option("--dataset", args->dataset,
                   "the sequence: EuRoC layout (mav0/cam0), TUM RGB-D folder or image folder")
       ->required();
@@ -71,6 +80,12 @@ void AddRunCommand(CLI::App& app, int& exit_status) {
                 "ignore the sequence's markers.json (keypoints only). Without this flag a "
                 "markers.json in the sequence puts the run in the marker world frame, with "
                 "metric scale and marker relocalisation");
+  run->add_option("--markers", args->markers,
+                  "known markers (markers.json) to use instead of the sequence's; markers it "
+                  "lacks are mapped online and written to markers.json (fixed: false)");
+  run->add_option("--marker-size", args->marker_size_m,
+                  "side in metres of markers the marker map lacks (0: that of its first marker)")
+      ->capture_default_str();
   run->add_flag("--blocking", args->blocking,
                 "track and map each frame in turn on one thread (deterministic)");
   run->add_flag("--quiet", args->quiet, "no progress line");

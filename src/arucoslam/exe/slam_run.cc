@@ -4,6 +4,7 @@
 
 #include <cstdio>
 
+#include "arucoslam/io/marker_map_json.h"
 #include "arucoslam/util/files.h"
 #include "arucoslam/util/timing.h"
 
@@ -71,6 +72,9 @@ SlamRunResult RunSlamOnDataset(const Dataset& dataset, const std::string& datase
   result.timing = system.Stats();
   WriteSlamOutput(staged.path(), result.trajectory, result.keyframes, system.MapPoints(),
                   result.stats);
+  if (options.marker_map) {
+    WriteMarkerMapJson(system.MarkerMapOutput(), staged.path() / "markers.json");
+  }
   staged.Commit();
   return result;
 }
