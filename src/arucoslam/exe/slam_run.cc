@@ -41,6 +41,7 @@ SlamRunStats MakeStats(const std::string& dataset_label, const Dataset& dataset,
                     {"tracking", stats.tracking_ms.Summarize()},
                     {"frame", stats.frame_ms.Summarize()},
                     {"local_mapping", stats.local_mapping_ms.Summarize()}};
+  if (markers) out.timings_ms.push_back({"markers", stats.marker_ms.Summarize()});
   return out;
 }
 

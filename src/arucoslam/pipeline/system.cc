@@ -15,7 +15,7 @@ bool SystemOptions::Check() const {
          locator.Check() && alignment.Check() && max_marker_rms_px > 0.0 &&
          min_alignment_anchors >= 2 && min_alignment_baseline_m >= 0.0 &&
          max_alignment_rms_m > 0.0 && marker_reset_lost_frames >= 1 &&
-         max_realignment_anchors >= min_alignment_anchors;
+         max_realignment_anchors >= min_alignment_anchors && marker_mapping.Check();
 }
 
 System::System(const CameraModel& camera, const SystemOptions& options)

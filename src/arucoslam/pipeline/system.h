@@ -83,6 +83,9 @@ struct SystemOptions {
   // Finish runs one bundle adjustment of the whole aligned map with every marker
   // observation (known markers fixed); otherwise only the mapped markers are refined.
   bool final_marker_bundle_adjustment = true;
+  // Mapped markers seen by at least this many keyframes locate frames like known ones
+  // (marker poses and relocalisation where the known map has no marker). 0: never.
+  int min_locating_marker_keyframes = 3;
   MarkerMapperOptions marker_mapping;
 
   bool Check() const;
@@ -196,6 +199,8 @@ class System {
   void FeedMarkerMapping(KeyframeId keyframe);
   void ResetMarkerMapping();
   void FinishMarkerMapping();
+  void PublishLocatingMarkers();  // mapping thread, after a keyframe's markers were added
+  std::shared_ptr<const MarkerMap> LocatingMarkers() const;
   void MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& report);
   void MapKeyframe(KeyframeId keyframe);
   void RecordPose(const Frame& frame, KeyframeId reference);
@@ -229,6 +234,9 @@ class System {
   // Markers of the world-aligned map; only the mapping thread touches it while it runs.
   std::unique_ptr<MarkerMapper> marker_mapper_;
   bool marker_mapping_live_ = false;  // the current map is aligned and feeds marker_mapper_
+  // Known + mapped markers that locate frames, published by the mapping thread.
+  mutable std::mutex locating_mutex_;
+  std::shared_ptr<const MarkerMap> locating_markers_;
 
   std::unique_ptr<BoundedQueue<KeyframeId>> queue_;
   std::thread mapping_thread_;

@@ -1,6 +1,7 @@
 // System's marker mapping: once the keypoint map is in the marker world, every keyframe's
 // marker observations go to a MarkerMapper (known markers fixed, unknown ones mapped online),
 // whose landmarks join local bundle adjustment; at the end the mapped markers are refined.
+#include <memory>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -51,6 +52,30 @@ void System::FeedMarkerMapping(KeyframeId keyframe) {
   for (const MarkerId& id : initialised) {
     ARUCOSLAM_LOG_DEBUG("keyframe {}: marker {} mapped", keyframe.value, id.value);
   }
+  PublishLocatingMarkers();
+}
+
+void System::PublishLocatingMarkers() {
+  if (options_.min_locating_marker_keyframes <= 0) return;
+  MarkerMap locating = *options_.marker_map;
+  bool any = false;
+  for (const auto& [id, landmark] : marker_mapper_->landmarks().landmarks()) {
+    if (landmark.fixed || locating.markers.count(id.value) != 0 ||
+        static_cast<int>(landmark.observations.size()) < options_.min_locating_marker_keyframes) {
+      continue;
+    }
+    locating.markers[id.value] = landmark.ToMarkerInfo();
+    any = true;
+  }
+  if (!any) return;
+  auto published = std::make_shared<const MarkerMap>(std::move(locating));
+  std::lock_guard lock(locating_mutex_);
+  locating_markers_ = std::move(published);
+}
+
+std::shared_ptr<const MarkerMap> System::LocatingMarkers() const {
+  std::lock_guard lock(locating_mutex_);
+  return locating_markers_;  // null until a mapped marker locates: the known map alone
 }
 
 void System::ResetMarkerMapping() {

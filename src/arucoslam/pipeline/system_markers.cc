@@ -36,7 +36,8 @@ std::optional<System::MarkerFix> System::LocateWithMarkers(
   for (const MarkerDetection& detection : detections) {
     frame.markers.push_back({MarkerId(detection.id), detection.corners});
   }
-  const MarkerMap& known = *options_.marker_map;
+  const std::shared_ptr<const MarkerMap> locating = LocatingMarkers();
+  const MarkerMap& known = locating ? *locating : *options_.marker_map;
   const CameraLocation location = LocateCamera(detections, known, camera_, options_.locator);
   report.num_markers = static_cast<int>(location.marker_ids.size());
   std::optional<MarkerFix> fix;

@@ -77,14 +77,17 @@ struct MarkerRun {
 };
 
 // Frames [blackout_begin, blackout_end) have neither keypoints nor markers. Every wall
-// marker is detected; the System knows `known` (default: all of them).
+// marker is detected; the System knows `known` (default: all of them). With `hide_known`,
+// the known markers are not detected after the blackout.
 MarkerRun RunWithMarkers(bool blocking, int num_frames, int blackout_begin = -1,
-                         int blackout_end = -1, std::optional<MarkerMap> known = std::nullopt) {
+                         int blackout_end = -1, std::optional<MarkerMap> known = std::nullopt,
+                         int min_locating_marker_keyframes = 3, bool hide_known = false) {
   const CameraModel camera = TestCamera();
   SyntheticFeatureScene scene(camera);
   SystemOptions options;
   options.blocking = blocking;
   options.marker_map = known ? *known : WallMarkers();
+  options.min_locating_marker_keyframes = min_locating_marker_keyframes;
   const MarkerMap wall = WallMarkers();
   System system(camera, options);
   std::mt19937 rng(7);
@@ -95,6 +98,11 @@ MarkerRun RunWithMarkers(bool blocking, int num_frames, int blackout_begin = -1,
     Frame frame = scene.MakeFrame(FrameId(t), kDt * t, cam_from_world, &truth);
     std::vector<MarkerDetection> detections =
         Detect(wall, camera, cam_from_world, rng);
+    if (hide_known && t >= blackout_end) {
+      std::erase_if(detections, [&](const MarkerDetection& detection) {
+        return options.marker_map->markers.count(detection.id) != 0;
+      });
+    }
     if (t >= blackout_begin && t < blackout_end) {
       frame.features = OrbFeatures();
       frame.ResetMatches();
@@ -220,6 +228,26 @@ TEST(SystemMarkers, MarkersTheMapLacksAreMappedOnline) {
   }
   // The camera's 3.6 m of travel sees the wall from x = -1.9 to 5.5 m: markers 0..10.
   EXPECT_GE(mapped, 8);
+
+}
+
+TEST(SystemMarkers, MappedMarkersLocateFramesWhereNoKnownMarkerIsSeen) {
+  // Marker 10 alone is known; from frame 100 on it is hidden and only mapped markers are
+  // in view. (The map is aligned at frame 91, measured.)
+  MarkerMap one = WallMarkers();
+  std::erase_if(one.markers, [](const auto& entry) { return entry.first != 10; });
+  const MarkerRun run = RunWithMarkers(true, 120, 100, 100, one, 3, true);
+  const MarkerRun known_only = RunWithMarkers(true, 120, 100, 100, one, 0, true);
+  int located = 0;
+  for (int t = 100; t < 120; ++t) {
+    EXPECT_EQ(known_only.reports[t].num_markers, 0) << t;
+    if (run.reports[t].num_markers == 0) continue;
+    ++located;
+    ASSERT_TRUE(run.reports[t].cam_from_world.has_value()) << t;
+    const Eigen::Vector3d centre = run.reports[t].cam_from_world->Inverse().translation;
+    EXPECT_LT((centre - WorldFromCam(t).translation).norm(), 0.05) << t;
+  }
+  EXPECT_GE(located, 15);
 }
 
 }  // namespace
