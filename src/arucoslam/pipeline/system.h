@@ -200,6 +200,12 @@ class System {
   void ResetMarkerMapping();
   void FinishMarkerMapping();
   void PublishLocatingMarkers();  // mapping thread, after a keyframe's markers were added
+  // The markers to add to a global BA (CollectMarkerFactors / ApplyMarkerFactors) or pose
+  // graph (MarkerPosePriors) of the current map; null before world alignment. Use it from
+  // the mapping thread or while it is stopped.
+  MarkerLandmarks* OptimisationMarkers() {
+    return marker_mapping_live_ ? marker_mapper_->mutable_landmarks() : nullptr;
+  }
   std::shared_ptr<const MarkerMap> LocatingMarkers() const;
   void MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& report);
   void MapKeyframe(KeyframeId keyframe);
