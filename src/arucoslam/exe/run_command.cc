@@ -1,5 +1,6 @@
 // `arucoslam run`: monocular SLAM over a sequence (EuRoC layout, TUM RGB-D folder or image
-// folder) -> trajectory.tum, keyframes.tum, map.ply and stats.json in one output folder;
+// folder) -> trajectory.tum, keyframes.tum, map.ply, stats.json (and with markers
+// markers.json: the known markers and the ones mapped online) in one output folder;
 // map reuse: --save-map writes the map file after the run, --load-map starts from one,
 // --localize-only tracks against it without changing it.
 #include <cstdio>
@@ -26,6 +27,8 @@ struct RunArgs {
   std::string camera;
   std::string vocabulary;  // empty: the default one
   bool no_loop_closing = false;
+  std::string markers;  // overrides the sequence's markers.json
+  double marker_size_m = 0.0;
   bool no_markers = false;
   bool blocking = false;
   bool quiet = false;
@@ -58,6 +61,9 @@ int RunSlam(const RunArgs& args) {
   }
   if (args.rate_hz < 0.0) throw InputError("--rate", "expected a rate >= 0 Hz");
   CheckMapArgs(args);
+  if (!(args.marker_size_m >= 0.0)) {
+    throw InputError("--marker-size", "expected a side >= 0 m, got " + std::to_string(args.marker_size_m));
+  }
   DatasetOptions dataset_options;
   dataset_options.camera_path = args.camera;
   dataset_options.rate_hz = args.rate_hz;
@@ -71,10 +77,12 @@ int RunSlam(const RunArgs& args) {
   // Low-contrast cells: 5 grey levels (extractor default 7) keeps keypoints on the faint marks
   // of plain walls; the medium-texture route's U-turn facing one stays tracked.
   options.extractor.min_fast_threshold = 5;
-  const std::optional<std::filesystem::path> markers_path = dataset.markers_path();
+  std::optional<std::filesystem::path> markers_path = dataset.markers_path();
+  if (!args.markers.empty()) markers_path = args.markers;
   if (markers_path && !args.no_markers) {
     options.marker_map = ReadMarkerMapJson(*markers_path);
     options.detector.dictionary = options.marker_map->dictionary;
+    options.marker_mapping.unknown_marker_size_m = args.marker_size_m;
   }
   const std::filesystem::path vocabulary =
       args.vocabulary.empty() ? DefaultVocabularyPath() : std::filesystem::path(args.vocabulary);
@@ -100,7 +108,8 @@ int RunSlam(const RunArgs& args) {
 void AddRunCommand(CLI::App& app, int& exit_status) {
   auto args = std::make_shared<RunArgs>();
   CLI::App* run = app.add_subcommand(
-      "run", "SLAM on a sequence -> trajectory.tum, keyframes.tum, map.ply, stats.json");
+      "run", "SLAM on a sequence -> trajectory.tum, keyframes.tum, map.ply, stats.json "
+             "(+ markers.json with a marker map)");
   run->add_option("--dataset", args->dataset,
                   "the sequence: EuRoC layout (mav0/cam0), TUM RGB-D folder or image folder")
       ->required();
@@ -118,6 +127,12 @@ void AddRunCommand(CLI::App& app, int& exit_status) {
                       std::string(kDefaultVocabularyName) + " shipped with arucoslam)");
   run->add_flag("--no-loop-closing", args->no_loop_closing,
                 "do not detect or close loops (relocalisation stays on)");
+  run->add_option("--markers", args->markers,
+                  "known markers (markers.json) to use instead of the sequence's; markers it "
+                  "lacks are mapped online and written to markers.json (fixed: false)");
+  run->add_option("--marker-size", args->marker_size_m,
+                  "side in metres of markers the marker map lacks (0: that of its first marker)")
+      ->capture_default_str();
   run->add_flag("--blocking", args->blocking,
                 "track and map each frame in turn on one thread (deterministic)");
   run->add_flag("--quiet", args->quiet, "no progress line");

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "arucoslam/io/calibration.h"
+#include "arucoslam/io/marker_map_json.h"
 #include "arucoslam/io/trajectory_io.h"
 #include "arucoslam/util/files.h"
 
@@ -197,6 +198,40 @@ TEST_F(RunCommandTest, BadInputIsOneLineAndExitTwo) {
   EXPECT_EQ(outcome.status, 2);
   EXPECT_NE(outcome.err.find("--features"), std::string::npos) << outcome.err;
   EXPECT_EQ(Run("run --out " + out.string()).status, 2);  // --dataset missing
+}
+
+TEST_F(RunCommandTest, MarkerMapIsWrittenToTheOutput) {
+  const fs::path data = fs::path(ARUCOSLAM_TEST_DATA_DIR) / "euroc_v101_micro";
+  if (!fs::exists(data)) GTEST_SKIP() << "test data missing: " << data;
+  MarkerMap known;
+  MarkerInfo info;
+  info.id = 7;
+  info.size = 0.25;
+  info.world_from_marker = Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(1.0, 2.0, 3.0));
+  known.markers[7] = info;
+  WriteMarkerMapJson(known, dir_ / "known.json");
+  const fs::path out = dir_ / "out";
+  const Outcome outcome = Run("run --dataset " + data.string() + " --markers " +
+                              (dir_ / "known.json").string() + " --marker-size 0.3 --out " +
+                              out.string() + " --blocking --quiet");
+  ASSERT_EQ(outcome.status, 0) << outcome.err;
+  // The camera stands still: nothing is mapped, the known marker comes back as it was.
+  const MarkerMap written = ReadMarkerMapJson(out / "markers.json");
+  ASSERT_EQ(written.markers.size(), 1u);
+  EXPECT_TRUE(written.markers.at(7).fixed);
+  EXPECT_DOUBLE_EQ(written.markers.at(7).size, 0.25);
+  EXPECT_NEAR(written.markers.at(7).world_from_marker.translation.y(), 2.0, 1e-9);
+
+  const Outcome bad = Run("run --dataset " + data.string() + " --markers " +
+                          (dir_ / "known.json").string() + " --marker-size -1 --out " +
+                          (dir_ / "out2").string());
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("--marker-size"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out2"));
+  const Outcome missing = Run("run --dataset " + data.string() + " --markers " +
+                              (dir_ / "none.json").string() + " --out " + (dir_ / "out3").string());
+  EXPECT_EQ(missing.status, 2);
+  EXPECT_NE(missing.err.find("none.json"), std::string::npos) << missing.err;
 }
 
 }  // namespace

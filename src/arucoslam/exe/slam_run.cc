@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "arucoslam/util/error.h"
+#include "arucoslam/io/marker_map_json.h"
 #include "arucoslam/util/files.h"
 #include "arucoslam/util/timing.h"
 
@@ -56,6 +57,7 @@ SlamRunStats MakeStats(const std::string& dataset_label, const Dataset& dataset,
     out.timings_ms.push_back(
         {"global_bundle_adjustment", stats.places.global_bundle_adjustment_ms.Summarize()});
   }
+  if (markers) out.timings_ms.push_back({"markers", stats.marker_ms.Summarize()});
   return out;
 }
 
@@ -113,6 +115,9 @@ SlamRunResult RunSlamOnDataset(const Dataset& dataset, const std::string& datase
     MapFileInfo info;
     info.world_aligned = system.world_aligned();
     SaveMapFile(system.map(), reuse.save, info);
+  }
+  if (options.marker_map) {
+    WriteMarkerMapJson(system.MarkerMapOutput(), staged.path() / "markers.json");
   }
   staged.Commit();
   return result;

@@ -1,7 +1,7 @@
 // RunSlamOnDataset: one SLAM run over a whole sequence, shared by `run` and `experiments`:
 // feeds every image to the System, then writes trajectory.tum, keyframes.tum, map.ply and
-// stats.json into an output folder (all-or-nothing); optionally starts from a saved map and
-// saves the map after the run.
+// stats.json (and with a marker map markers.json: known + mapped markers) into an output
+// folder (all-or-nothing); optionally starts from a saved map and saves the map after the run.
 #pragma once
 
 #include <filesystem>

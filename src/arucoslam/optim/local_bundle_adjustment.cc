@@ -137,10 +137,18 @@ int WriteBack(MapData& data, const Snapshot& snapshot, const BundleAdjustmentSum
 }  // namespace
 
 LocalBundleAdjustmentResult RunLocalBundleAdjustment(Map& map, KeyframeId keyframe,
-                                                     const LocalBundleAdjustmentOptions& options) {
+                                                     const LocalBundleAdjustmentOptions& options,
+                                                     MarkerLandmarks* markers) {
   LocalBundleAdjustmentResult result;
-  Snapshot snapshot =
-      map.Read([&](const MapData& data) { return TakeSnapshot(data, keyframe, options); });
+  MarkerFactors factors;
+  Snapshot snapshot = map.Read([&](const MapData& data) {
+    Snapshot taken = TakeSnapshot(data, keyframe, options);
+    if (markers != nullptr) {
+      factors = CollectMarkerFactors(data, taken.keyframe_ids, *markers, options.markers);
+    }
+    return taken;
+  });
+  result.num_marker_observations = static_cast<int>(factors.observations.size());
   result.num_local_keyframes = snapshot.num_local;
   result.num_fixed_keyframes = snapshot.num_fixed;
   result.num_points = static_cast<int>(snapshot.problem.points.size());
@@ -148,8 +156,10 @@ LocalBundleAdjustmentResult RunLocalBundleAdjustment(Map& map, KeyframeId keyfra
     result.summary.message = "no observations in the local window";
     return result;
   }
-  result.summary = SolveBundleAdjustment(options.solver, &snapshot.problem);
+  result.summary = SolveBundleAdjustmentWithMarkers(options.solver, options.markers, &factors,
+                                                    &snapshot.problem);
   if (!result.summary.success) return result;
+  if (markers != nullptr) result.num_moved_markers = ApplyMarkerFactors(factors, markers);
   result.num_erased_observations = map.Write([&](MapData& data) {
     return WriteBack(data, snapshot, result.summary, options.erase_outliers);
   });

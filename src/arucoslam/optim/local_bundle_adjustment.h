@@ -3,7 +3,9 @@
 #pragma once
 
 #include "arucoslam/map/map.h"
+#include "arucoslam/map/marker_landmark.h"
 #include "arucoslam/optim/bundle_adjustment.h"
+#include "arucoslam/optim/marker_factors.h"
 
 namespace arucoslam {
 
@@ -22,10 +24,12 @@ struct LocalBundleAdjustmentOptions {
   // Erase observations the solve flags as outliers (chi-square test); points left with no
   // observation are erased.
   bool erase_outliers = true;
+  // Marker-corner residuals of the window's keyframes (when markers are given).
+  MarkerFactorOptions markers;
 
   bool Check() const {
     return solver.Check() && max_covisible_keyframes >= 0 && min_fixed_keyframes >= 0 &&
-           min_anchor_points >= 0;
+           min_anchor_points >= 0 && markers.Check();
   }
 };
 
@@ -35,11 +39,16 @@ struct LocalBundleAdjustmentResult {
   int num_fixed_keyframes = 0;
   int num_points = 0;
   int num_erased_observations = 0;
+  int num_marker_observations = 0;  // marker-corner residual blocks (8-vectors)
+  int num_moved_markers = 0;        // non-fixed markers whose pose was updated
   BundleAdjustmentSummary summary;
 };
 
 // Keyframes and points erased by another thread during the solve are skipped on write-back.
+// With `markers`, the window's keyframes' marker observations join the solve (fixed markers
+// held, the others estimated and written back); the caller owns `markers` exclusively.
 LocalBundleAdjustmentResult RunLocalBundleAdjustment(
-    Map& map, KeyframeId keyframe, const LocalBundleAdjustmentOptions& options = {});
+    Map& map, KeyframeId keyframe, const LocalBundleAdjustmentOptions& options = {},
+    MarkerLandmarks* markers = nullptr);
 
 }  // namespace arucoslam

@@ -15,7 +15,8 @@ bool SystemOptions::Check() const {
          locator.Check() && alignment.Check() && max_marker_rms_px > 0.0 &&
          min_alignment_anchors >= 2 && min_alignment_baseline_m >= 0.0 &&
          max_alignment_rms_m > 0.0 && marker_reset_lost_frames >= 1 &&
-         max_realignment_anchors >= min_alignment_anchors && places.Check();
+         max_realignment_anchors >= min_alignment_anchors && places.Check() &&
+         marker_mapping.Check();
 }
 
 System::System(const CameraModel& camera, const SystemOptions& options)
@@ -56,6 +57,7 @@ void System::Finish() {
   finished_ = true;
   StopMappingThread();
   if (places_) places_->Finish();
+  FinishMarkerMapping();
 }
 
 bool System::MapperIdle() const {
@@ -67,6 +69,7 @@ void System::MapKeyframe(KeyframeId keyframe) {
   const Stopwatch watch;
   std::unique_lock<std::mutex> edit;  // a loop being closed pauses local mapping
   if (places_) edit = places_->LockMapEdits();
+  FeedMarkerMapping(keyframe);
   const LocalMappingResult r = mapper_->ProcessKeyframe(keyframe);
   const double elapsed = watch.ElapsedMilliseconds();
   if (places_) {
@@ -320,6 +323,7 @@ void System::ResetMap() {
   tracker_ = std::make_unique<Tracker>(*map_, options_.tracker);
   mapper_ = std::make_unique<LocalMapper>(*map_, options_.mapper);
   MakePlaceRecognition();
+  ResetMarkerMapping();
   poses_ = std::move(kept);
   init_reference_.reset();
   init_reference_fix_.reset();

@@ -26,6 +26,7 @@
 #include "arucoslam/slam/keyframe_policy.h"
 #include "arucoslam/slam/local_mapper.h"
 #include "arucoslam/slam/map_initialization.h"
+#include "arucoslam/slam/marker_mapper.h"
 #include "arucoslam/slam/tracker.h"
 #include "arucoslam/slam/world_alignment.h"
 #include "arucoslam/util/timing.h"
@@ -77,6 +78,17 @@ struct SystemOptions {
   // the map does not take them back: the map is discarded and a new one initialised and
   // aligned (the poses already output are kept).
   int marker_reset_lost_frames = 10;
+  // Once the map is world-aligned, keyframes' marker observations join local BA (known
+  // markers fixed) and markers the map lacks are mapped (system_marker_mapping.cc).
+  bool markers_in_local_ba = true;
+  bool map_unknown_markers = true;
+  // Finish runs one bundle adjustment of the whole aligned map with every marker
+  // observation (known markers fixed); otherwise only the mapped markers are refined.
+  bool final_marker_bundle_adjustment = true;
+  // Mapped markers seen by at least this many keyframes locate frames like known ones
+  // (marker poses and relocalisation where the known map has no marker). 0: never.
+  int min_locating_marker_keyframes = 3;
+  MarkerMapperOptions marker_mapping;
 
   // Bag-of-words vocabulary. When set, keyframes enter a place database: lost tracking is
   // relocalised from it and, with places.loop_closing, loops are closed. Null: neither.
@@ -161,6 +173,9 @@ class System {
   const Map& map() const { return *map_; }
   TrackingState state() const { return tracker_ ? tracker_->state() : TrackingState::kNotInitialized; }
   bool world_aligned() const { return world_aligned_; }
+  // The known markers (fixed as in markers.json) and the ones mapped online (fixed: false).
+  // Call after Finish. Empty without a marker map.
+  MarkerMap MarkerMapOutput() const;
   // Copy of the statistics (the mapping thread adds to local_mapping_ms).
   SystemStats Stats() const;
 
@@ -184,7 +199,7 @@ class System {
   void Initialize(Frame& frame, FrameReport& report);
   void Track(Frame& frame, FrameReport& report);
   // Marker handling (system_markers.cc).
-  std::optional<MarkerFix> LocateWithMarkers(const Frame& frame,
+  std::optional<MarkerFix> LocateWithMarkers(Frame& frame,
                                              const std::vector<MarkerDetection>& detections,
                                              FrameReport& report);
   bool RelocalizeWithMarkers(Frame& frame, FrameReport& report);
@@ -209,6 +224,21 @@ class System {
   void ReanchorOrphanPoses();
   // Held while the map is moved from outside (world alignment); empty without places.
   std::unique_lock<std::mutex> LockPlacesForMapMove();
+  // Marker mapping (system_marker_mapping.cc). Start: on each world alignment, with the
+  // mapping thread stopped. Feed: a keyframe's markers, before its local mapping. Reset:
+  // after the map was replaced. Finish: final marker refinement.
+  void StartMarkerMapping();
+  void FeedMarkerMapping(KeyframeId keyframe);
+  void ResetMarkerMapping();
+  void FinishMarkerMapping();
+  void PublishLocatingMarkers();  // mapping thread, after a keyframe's markers were added
+  // The markers to add to a global BA (CollectMarkerFactors / ApplyMarkerFactors) or pose
+  // graph (MarkerPosePriors) of the current map; null before world alignment. Use it from
+  // the mapping thread or while it is stopped.
+  MarkerLandmarks* OptimisationMarkers() {
+    return marker_mapping_live_ ? marker_mapper_->mutable_landmarks() : nullptr;
+  }
+  std::shared_ptr<const MarkerMap> LocatingMarkers() const;
   void MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& report);
   void MapKeyframe(KeyframeId keyframe);
   void RecordPose(const Frame& frame, KeyframeId reference);
@@ -239,6 +269,12 @@ class System {
   int next_alignment_anchors_ = 0;  // alignment is tried again at this many anchors
   int lost_with_markers_ = 0;
   double detection_ms_ = 0.0;  // marker detection time of the current image
+  // Markers of the world-aligned map; only the mapping thread touches it while it runs.
+  std::unique_ptr<MarkerMapper> marker_mapper_;
+  bool marker_mapping_live_ = false;  // the current map is aligned and feeds marker_mapper_
+  // Known + mapped markers that locate frames, published by the mapping thread.
+  mutable std::mutex locating_mutex_;
+  std::shared_ptr<const MarkerMap> locating_markers_;
 
   bool map_loaded_ = false;    // started from a saved map (StartFromMap)
   bool localize_only_ = false;

@@ -29,10 +29,15 @@ double Baseline(const std::vector<WorldAnchor>& anchors) {
 }  // namespace
 
 std::optional<System::MarkerFix> System::LocateWithMarkers(
-    const Frame& frame, const std::vector<MarkerDetection>& detections, FrameReport& report) {
+    Frame& frame, const std::vector<MarkerDetection>& detections, FrameReport& report) {
   if (!options_.marker_map) return std::nullopt;
   const Stopwatch watch;
-  const MarkerMap& known = *options_.marker_map;
+  frame.markers.clear();
+  for (const MarkerDetection& detection : detections) {
+    frame.markers.push_back({MarkerId(detection.id), detection.corners});
+  }
+  const std::shared_ptr<const MarkerMap> locating = LocatingMarkers();
+  const MarkerMap& known = locating ? *locating : *options_.marker_map;
   const CameraLocation location = LocateCamera(detections, known, camera_, options_.locator);
   report.num_markers = static_cast<int>(location.marker_ids.size());
   std::optional<MarkerFix> fix;
@@ -114,7 +119,11 @@ void System::MaybeAlignWorld(Frame* frame) {
   const Sim3& world_from_map = alignment.world_from_map;
   StopMappingThread();  // every queued keyframe is mapped first; mapping is idle below
   const std::unique_lock<std::mutex> places_lock = LockPlacesForMapMove();
-  map_->Write([&](MapData& data) { ApplyWorldAlignment(world_from_map, &data); });
+  // On a re-alignment the markers mapped in the previous estimate of the world move too.
+  MarkerLandmarks* mapped =
+      marker_mapping_live_ ? marker_mapper_->mutable_landmarks() : nullptr;
+  map_->Write([&](MapData& data) { ApplyWorldAlignment(world_from_map, &data, mapped); });
+  StartMarkerMapping();
   tracker_->ApplySimilarity(world_from_map);
   const auto to_world = [&](const Rigid3& cam_from_map) {
     return world_from_map.TransformPose(cam_from_map.Inverse()).Inverse();

@@ -14,7 +14,7 @@ bool LocalMapperOptions::Check() const {
          fusion_neighbours >= 0 && fusion_radius_px > 0.0 && fusion_max_distance >= 0 &&
          min_found_ratio >= 0.0 && min_found_ratio <= 1.0 && min_point_observations >= 1 &&
          bundle_adjustment.Check() && redundant_fraction > 0.0 && redundant_fraction <= 1.0 &&
-         redundant_observers >= 1;
+         redundant_observers >= 1 && min_marker_keyframes >= 0;
 }
 
 LocalMapper::LocalMapper(Map& map, const LocalMapperOptions& options)
@@ -40,7 +40,7 @@ LocalMappingResult LocalMapper::ProcessKeyframe(KeyframeId keyframe) {
   watch.Restart();
   if (options_.run_bundle_adjustment && map_.NumKeyframes() > 2) {
     result.bundle_adjustment =
-        RunLocalBundleAdjustment(map_, keyframe, options_.bundle_adjustment);
+        RunLocalBundleAdjustment(map_, keyframe, options_.bundle_adjustment, markers_);
   }
   result.bundle_adjustment_ms = watch.ElapsedMilliseconds();
   watch.Restart();
@@ -105,6 +105,19 @@ bool IsRedundant(const MapData& data, const Keyframe& candidate, double fraction
   return num_points > 0 && num_redundant > fraction * num_points;
 }
 
+// Whether `candidate` saw a marker of `markers` that fewer than `min_others` other
+// keyframes saw.
+bool HoldsRareMarkerView(const Keyframe& candidate, const MarkerLandmarks* markers,
+                         int min_others) {
+  if (markers == nullptr) return false;
+  for (const MarkerObservation& observation : candidate.markers) {
+    const MarkerLandmark* landmark = markers->Find(observation.marker_id);
+    if (landmark == nullptr || landmark->observations.count(candidate.id) == 0) continue;
+    if (static_cast<int>(landmark->observations.size()) - 1 < min_others) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 int LocalMapper::CullRedundantKeyframes(KeyframeId keyframe) {
@@ -122,11 +135,14 @@ int LocalMapper::CullRedundantKeyframes(KeyframeId keyframe) {
     for (const KeyframeId& id : candidates) {
       const Keyframe* candidate = data.FindKeyframe(id);
       if (candidate == nullptr ||
+          HoldsRareMarkerView(*candidate, markers_, options_.min_marker_keyframes) ||
           !IsRedundant(data, *candidate, options_.redundant_fraction,
                        options_.redundant_observers)) {
         continue;
       }
-      erased += data.EraseKeyframe(id) ? 1 : 0;
+      if (!data.EraseKeyframe(id)) continue;
+      ++erased;
+      if (markers_ != nullptr) markers_->EraseKeyframe(id);
     }
     return erased;
   });

@@ -52,6 +52,9 @@ struct LocalMapperOptions {
   double redundant_fraction = 0.9;
   int redundant_observers = 3;
   bool cull_keyframes = true;
+  // With marker landmarks set: a keyframe is kept while one of the markers it saw is seen
+  // by fewer than this many other keyframes (a marker's views hold its pose and the scale).
+  int min_marker_keyframes = 3;
 
   bool Check() const;
 };
@@ -86,10 +89,14 @@ class LocalMapper {
   int CullRedundantKeyframes(KeyframeId keyframe);
 
   const LocalMapperOptions& options() const { return options_; }
+  // Markers whose observations join local BA (null: none). Used only inside
+  // ProcessKeyframe: the caller may change them between calls, not during one.
+  void SetMarkerLandmarks(MarkerLandmarks* markers) { markers_ = markers; }
 
  private:
   Map& map_;
   LocalMapperOptions options_;
+  MarkerLandmarks* markers_ = nullptr;
   int num_processed_ = 0;  // keyframes processed so far
   // Points created here, with the value of num_processed_ when they were made.
   std::vector<std::pair<MapPointId, int>> recent_points_;

@@ -13,6 +13,7 @@ MarkerMapper::MarkerMapper(const MarkerMap& known, const MarkerMapperOptions& op
   if (!(unknown_size_ > 0.0) && !known.markers.empty()) {
     unknown_size_ = known.markers.begin()->second.size;
   }
+  if (!options.map_unknown) unknown_size_ = 0.0;
 }
 
 std::vector<MarkerId> MarkerMapper::AddKeyframe(KeyframeId keyframe, const Rigid3& cam_from_world,
@@ -37,6 +38,19 @@ void MarkerMapper::EraseKeyframe(KeyframeId keyframe) {
     std::erase_if(views, [&](const View& view) { return view.keyframe == keyframe; });
   }
   std::erase_if(pending_, [](const auto& entry) { return entry.second.empty(); });
+}
+
+void MarkerMapper::SyncKeyframes(const MapData& map) {
+  std::vector<KeyframeId> gone;
+  for (auto& [id, record] : keyframes_) {
+    const Keyframe* keyframe = map.FindKeyframe(id);
+    if (keyframe == nullptr) {
+      gone.push_back(id);
+    } else {
+      record.cam_from_world = keyframe->cam_from_world;
+    }
+  }
+  for (const KeyframeId& id : gone) EraseKeyframe(id);
 }
 
 void MarkerMapper::Observe(KeyframeId keyframe, const MarkerObservation& observation,

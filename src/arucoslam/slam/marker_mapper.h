@@ -18,6 +18,8 @@ struct MarkerMapperOptions {
   // Side of the markers absent from the known map, metres. 0: the side of the known map's
   // first marker (no unknown marker is mapped when the known map is empty too).
   double unknown_marker_size_m = 0.0;
+  // False: only the known markers' observations are recorded, none is mapped.
+  bool map_unknown = true;
   // IPPE ambiguity test of a single view (see marker_pose.h).
   MarkerPoseOptions marker_pose;
   // A first view whose best IPPE solution reprojects worse than this (RMS, pixels) is not
@@ -48,6 +50,9 @@ class MarkerMapper {
                                     const std::vector<MarkerObservation>& markers);
   // Forgets a keyframe (culled by the local mapper).
   void EraseKeyframe(KeyframeId keyframe);
+  // Takes the current pose of every recorded keyframe from `map` (optimisation moved them)
+  // and forgets the ones `map` no longer holds (culled, or the map was reset).
+  void SyncKeyframes(const MapData& map);
 
   // Bundle adjustment of every keyframe and point of `map` with the marker observations:
   // known markers fixed, mapped ones estimated. Poses, points and marker poses are written
@@ -57,6 +62,9 @@ class MarkerMapper {
   MarkerBundleAdjustmentSummary RefineMarkers();
 
   const MarkerLandmarks& landmarks() const { return landmarks_; }
+  // For optimisations that estimate the mapped markers with the keyframes (local BA).
+  MarkerLandmarks* mutable_landmarks() { return &landmarks_; }
+  bool Records(KeyframeId keyframe) const { return keyframes_.count(keyframe) > 0; }
   // Known and mapped markers (mapped ones with fixed: false); pending ones are left out.
   MarkerMap ToMarkerMap() const;
   int NumPending() const { return static_cast<int>(pending_.size()); }

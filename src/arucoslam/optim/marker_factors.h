@@ -1,0 +1,73 @@
+// Marker factors for keyframe optimisations: the corner observations a MarkerLandmarks holds
+// for the keyframes of a bundle adjustment (known markers fixed, mapped ones estimated), the
+// joint solve, and marker pose priors for a pose graph. Shared by local and global BA.
+#pragma once
+
+#include <vector>
+
+#include "arucoslam/map/map_data.h"
+#include "arucoslam/map/marker_landmark.h"
+#include "arucoslam/optim/bundle_adjustment.h"
+#include "arucoslam/optim/marker_bundle_adjustment.h"
+#include "arucoslam/optim/pose_graph.h"
+
+namespace arucoslam {
+
+struct MarkerFactorOptions {
+  double corner_sigma_px = 1.0;  // corner noise given to the solver, pixels
+  // Marker residual robustness and outlier test (see MarkerBundleAdjustmentOptions).
+  double marker_huber_delta = 3.937892;
+  double marker_chi_square_threshold = kChiSquare8Dof95;
+  // Pose priors (MarkerPosePriors): a keyframe needs this many fixed markers in view, and
+  // the prior's standard deviations are these per marker seen (divided by sqrt(count)).
+  int min_prior_markers = 1;
+  double prior_position_sigma_m = 0.05;
+  double prior_rotation_sigma_rad = 0.02;
+
+  bool Check() const {
+    return corner_sigma_px > 0.0 && marker_huber_delta > 0.0 &&
+           marker_chi_square_threshold > 0.0 && min_prior_markers >= 1 &&
+           prior_position_sigma_m > 0.0 && prior_rotation_sigma_rad > 0.0;
+  }
+};
+
+// The markers and corner observations to add to one keypoint problem. Collect it under the
+// map's lock (it reads keyframe cameras), solve without it.
+struct MarkerFactors {
+  std::vector<MarkerBundleAdjustmentProblem::Marker> markers;
+  std::vector<MarkerBundleAdjustmentProblem::CornerObservation> observations;
+  std::vector<MarkerId> marker_ids;  // per entry of `markers`
+  int num_fixed_markers = 0;         // fixed markers with at least one observation
+
+  bool empty() const { return observations.empty(); }
+};
+
+// Every landmark seen by a keyframe of `keyframe_ids` (problem pose i is keyframe_ids[i]),
+// with those observations (corners undistorted with the keyframe's camera). Keyframes that
+// are not in `data` are skipped.
+MarkerFactors CollectMarkerFactors(const MapData& data, const std::vector<KeyframeId>& keyframe_ids,
+                                   const MarkerLandmarks& landmarks,
+                                   const MarkerFactorOptions& options = {});
+
+// Solves `problem` with the marker factors (their marker poses updated in place when not
+// fixed). The summary is the keypoint side's: `outliers` per keypoint observation;
+// `marker_outliers` (when not null) gets one flag per factor observation. Without factors
+// this is SolveBundleAdjustment.
+BundleAdjustmentSummary SolveBundleAdjustmentWithMarkers(const BundleAdjustmentOptions& solver,
+                                                         const MarkerFactorOptions& options,
+                                                         MarkerFactors* factors,
+                                                         BundleAdjustmentProblem* problem,
+                                                         std::vector<bool>* marker_outliers = nullptr);
+
+// Writes the solved poses of non-fixed markers back into `landmarks`; returns how many.
+int ApplyMarkerFactors(const MarkerFactors& factors, MarkerLandmarks* landmarks);
+
+// Absolute pose priors for a pose graph (node i is keyframe_ids[i]): for each keyframe that
+// sees at least min_prior_markers fixed markers, its pose from those markers' corners alone
+// (refined from the keyframe's current pose), when the corners fit within the chi-square test.
+std::vector<PoseGraphProblem::PosePrior> MarkerPosePriors(const MapData& data,
+                                                          const std::vector<KeyframeId>& keyframe_ids,
+                                                          const MarkerLandmarks& landmarks,
+                                                          const MarkerFactorOptions& options = {});
+
+}  // namespace arucoslam

@@ -1,0 +1,117 @@
+// System's marker mapping: once the keypoint map is in the marker world, every keyframe's
+// marker observations go to a MarkerMapper (known markers fixed, unknown ones mapped online),
+// whose landmarks join local bundle adjustment; at the end the mapped markers are refined.
+#include <memory>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "arucoslam/pipeline/system.h"
+#include "arucoslam/util/logging.h"
+
+namespace arucoslam {
+
+void System::StartMarkerMapping() {
+  if (!options_.marker_map) return;
+  if (!marker_mapper_) {
+    MarkerMapperOptions mapping = options_.marker_mapping;
+    mapping.map_unknown = mapping.map_unknown && options_.map_unknown_markers;
+    marker_mapper_ = std::make_unique<MarkerMapper>(*options_.marker_map, mapping);
+  }
+  marker_mapping_live_ = true;
+  if (options_.markers_in_local_ba) {
+    mapper_->SetMarkerLandmarks(marker_mapper_->mutable_landmarks());
+  }
+  // Keyframes mapped before the alignment are recorded now, at their aligned poses.
+  const std::vector<KeyframeId> keyframes = map_->Read([&](const MapData& data) {
+    std::vector<KeyframeId> ids;
+    for (const auto& [id, keyframe] : data.keyframes()) {
+      if (!marker_mapper_->Records(id)) ids.push_back(id);
+    }
+    return ids;
+  });
+  for (const KeyframeId& id : keyframes) FeedMarkerMapping(id);
+}
+
+void System::FeedMarkerMapping(KeyframeId keyframe) {
+  if (!marker_mapping_live_) return;
+  struct Seen {
+    Rigid3 cam_from_world;
+    CameraModel camera;
+    std::vector<MarkerObservation> markers;
+  };
+  const std::optional<Seen> seen = map_->Read([&](const MapData& data) -> std::optional<Seen> {
+    marker_mapper_->SyncKeyframes(data);
+    const Keyframe* found = data.FindKeyframe(keyframe);
+    if (found == nullptr) return std::nullopt;
+    return Seen{found->cam_from_world, found->camera, found->markers};
+  });
+  if (!seen || seen->markers.empty()) return;
+  const std::vector<MarkerId> initialised =
+      marker_mapper_->AddKeyframe(keyframe, seen->cam_from_world, seen->camera, seen->markers);
+  for (const MarkerId& id : initialised) {
+    ARUCOSLAM_LOG_DEBUG("keyframe {}: marker {} mapped", keyframe.value, id.value);
+  }
+  PublishLocatingMarkers();
+}
+
+void System::PublishLocatingMarkers() {
+  if (options_.min_locating_marker_keyframes <= 0) return;
+  MarkerMap locating = *options_.marker_map;
+  bool any = false;
+  for (const auto& [id, landmark] : marker_mapper_->landmarks().landmarks()) {
+    if (landmark.fixed || locating.markers.count(id.value) != 0 ||
+        static_cast<int>(landmark.observations.size()) < options_.min_locating_marker_keyframes) {
+      continue;
+    }
+    locating.markers[id.value] = landmark.ToMarkerInfo();
+    any = true;
+  }
+  if (!any) return;
+  auto published = std::make_shared<const MarkerMap>(std::move(locating));
+  std::lock_guard lock(locating_mutex_);
+  locating_markers_ = std::move(published);
+}
+
+std::shared_ptr<const MarkerMap> System::LocatingMarkers() const {
+  std::lock_guard lock(locating_mutex_);
+  return locating_markers_;  // null until a mapped marker locates: the known map alone
+}
+
+void System::ResetMarkerMapping() {
+  marker_mapping_live_ = false;
+  if (!marker_mapper_) return;
+  // The markers stay (they are in the world frame); the old map's keyframes go.
+  map_->Read([&](const MapData& data) {
+    marker_mapper_->SyncKeyframes(data);
+    return 0;
+  });
+}
+
+void System::FinishMarkerMapping() {
+  if (!marker_mapper_) return;
+  map_->Read([&](const MapData& data) {
+    marker_mapper_->SyncKeyframes(data);
+    return 0;
+  });
+  if (marker_mapping_live_ && options_.final_marker_bundle_adjustment) {
+    const MarkerBundleAdjustmentSummary summary =
+        map_->Write([&](MapData& data) { return marker_mapper_->Refine(&data); });
+    ARUCOSLAM_LOG_DEBUG("final bundle adjustment with markers: {}", summary.BriefReport());
+    return;
+  }
+  int num_mapped = 0;
+  for (const auto& [id, landmark] : marker_mapper_->landmarks().landmarks()) {
+    if (!landmark.fixed) ++num_mapped;
+  }
+  if (num_mapped == 0) return;
+  const MarkerBundleAdjustmentSummary summary = marker_mapper_->RefineMarkers();
+  ARUCOSLAM_LOG_DEBUG("{} mapped markers refined: {}", num_mapped, summary.BriefReport());
+}
+
+MarkerMap System::MarkerMapOutput() const {
+  if (marker_mapper_) return marker_mapper_->ToMarkerMap();
+  return options_.marker_map ? *options_.marker_map : MarkerMap();
+}
+
+}  // namespace arucoslam
