@@ -15,7 +15,8 @@ bool SystemOptions::Check() const {
          locator.Check() && alignment.Check() && max_marker_rms_px > 0.0 &&
          min_alignment_anchors >= 2 && min_alignment_baseline_m >= 0.0 &&
          max_alignment_rms_m > 0.0 && marker_reset_lost_frames >= 1 &&
-         max_realignment_anchors >= min_alignment_anchors;
+         max_realignment_anchors >= min_alignment_anchors && new_map_after_lost_s > 0.0 &&
+         min_marker_init_baseline_m > 0.0 && min_marker_init_parallax_deg >= 0.0;
 }
 
 System::System(const CameraModel& camera, const SystemOptions& options)
@@ -148,6 +149,7 @@ void System::Initialize(Frame& frame, FrameReport& report) {
     std::lock_guard lock(stats_mutex_);
     ++stats_.num_initialization_attempts;
   }
+  if (InitializeFromMarkers(frame, report)) return;
   const InitializationResult result =
       initializer_.Initialize(init_reference_->features, frame.features, camera_);
   report.message = result.message;
@@ -168,9 +170,14 @@ void System::Initialize(Frame& frame, FrameReport& report) {
     report.message = created.message;
     return;
   }
+  FinishInitialization(first, frame, created.first, created.second, created.num_points, report);
+}
+
+void System::FinishInitialization(Frame& first, Frame& frame, KeyframeId first_id,
+                                  KeyframeId second_id, int num_points, FrameReport& report) {
   init_reference_.reset();
-  tracker_->Start(frame, created.second);
-  RecordPose(first, created.first);
+  tracker_->Start(frame, second_id);
+  RecordPose(first, first_id);
   // The reference frame may have got a marker-only pose when it was seen: that entry is
   // replaced in place (the order of poses_ stays the order of time).
   for (std::size_t i = 0; i + 1 < poses_.size(); ++i) {
@@ -180,9 +187,9 @@ void System::Initialize(Frame& frame, FrameReport& report) {
       break;
     }
   }
-  RecordPose(frame, created.second);
-  AddAnchor(created.first, init_reference_fix_);
-  AddAnchor(created.second, fix_);
+  RecordPose(frame, second_id);
+  AddAnchor(first_id, init_reference_fix_);
+  AddAnchor(second_id, fix_);
   init_reference_fix_.reset();
   MaybeAlignWorld(&frame);
   frames_since_keyframe_ = 0;
@@ -191,8 +198,8 @@ void System::Initialize(Frame& frame, FrameReport& report) {
   report.cam_from_world = frame.cam_from_world;
   report.initialized_map = true;
   report.new_keyframe = true;
-  report.num_inliers = created.num_points;
-  report.message = "map initialised with " + std::to_string(created.num_points) + " points";
+  report.num_inliers = num_points;
+  report.message = "map initialised with " + std::to_string(num_points) + " points";
   std::lock_guard lock(stats_mutex_);
   ++stats_.num_initializations;
   stats_.num_keyframes_inserted += 2;
@@ -220,13 +227,22 @@ void System::Track(Frame& frame, FrameReport& report) {
     // keep coming and it does not take them back.
     const bool stuck = fix_ && ++lost_with_markers_ >= options_.marker_reset_lost_frames;
     const bool young = static_cast<int>(map_->NumKeyframes()) <= options_.reset_max_keyframes;
-    if (stuck || (young && !world_aligned_)) {
+    if (LostTooLong(frame)) {
+      ARUCOSLAM_LOG_DEBUG("frame {}: lost for {:.1f} s, starting a new map", report.index,
+                          options_.new_map_after_lost_s);
+      {
+        std::lock_guard lock(stats_mutex_);
+        ++stats_.num_new_maps_after_loss;
+      }
+      ResetMap();
+    } else if (stuck || (young && !world_aligned_)) {
       ResetMap();
     }
     return;
   }
   last_state_ = TrackingState::kTracking;
   lost_with_markers_ = 0;
+  lost_since_s_.reset();
   ++frames_since_keyframe_;
   MaybeInsertKeyframe(frame, result.num_inliers, report);
   report.cam_from_world = frame.cam_from_world;
@@ -281,6 +297,7 @@ void System::RecordPose(const Frame& frame, KeyframeId reference) {
 
 void System::ResetMap() {
   StopMappingThread();
+  CloseMap();
   // Poses already in the world frame stay, frozen at their current estimate.
   std::vector<TrackedPose> kept;
   map_->Read([&](const MapData& data) {
@@ -306,6 +323,7 @@ void System::ResetMap() {
   next_alignment_anchors_ = 0;
   world_aligned_ = false;
   lost_with_markers_ = 0;
+  lost_since_s_.reset();
   last_state_ = TrackingState::kNotInitialized;
   mapping_busy_ = false;
   StartMappingThread();
@@ -314,9 +332,16 @@ void System::ResetMap() {
 }
 
 std::vector<StampedPose> System::Trajectory() const {
+  if (options_.marker_map) return CurrentMapPoses(/*world_only=*/true);
+  if (map_->NumKeyframes() >= biggest_closed_keyframes_) return CurrentMapPoses(false);
+  return biggest_closed_poses_;
+}
+
+std::vector<StampedPose> System::CurrentMapPoses(bool world_only) const {
   std::vector<StampedPose> trajectory;
   map_->Read([&](const MapData& data) {
     for (const TrackedPose& pose : poses_) {
+      if (world_only && !pose.in_world) continue;
       const Keyframe* reference = data.FindKeyframe(pose.reference);
       const Rigid3 cam_from_world =
           reference ? pose.cam_from_reference * reference->cam_from_world : pose.cam_from_world;
@@ -328,21 +353,25 @@ std::vector<StampedPose> System::Trajectory() const {
 }
 
 std::vector<StampedPose> System::KeyframePoses() const {
-  return map_->Read([](const MapData& data) {
-    std::vector<StampedPose> poses;
+  std::vector<StampedPose> poses = closed_keyframes_;
+  if (options_.marker_map && !world_aligned_) return poses;  // not in the world frame
+  map_->Read([&](const MapData& data) {
     for (const auto& [id, keyframe] : data.keyframes()) {
       poses.push_back({keyframe.timestamp_s, keyframe.cam_from_world.Inverse()});
     }
-    return poses;
+    return 0;
   });
+  return poses;
 }
 
 std::vector<Eigen::Vector3d> System::MapPoints() const {
-  return map_->Read([](const MapData& data) {
-    std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector3d> points = closed_points_;
+  if (options_.marker_map && !world_aligned_) return points;  // not in the world frame
+  map_->Read([&](const MapData& data) {
     for (const auto& [id, point] : data.map_points()) points.push_back(point.p_in_world);
-    return points;
+    return 0;
   });
+  return points;
 }
 
 SystemStats System::Stats() const {

@@ -75,6 +75,15 @@ struct SystemOptions {
   // the map does not take them back: the map is discarded and a new one initialised and
   // aligned (the poses already output are kept).
   int marker_reset_lost_frames = 10;
+  // Tracking lost for this long (seconds) and not relocalised: a new map is started (the
+  // old one is closed; see System::Trajectory for which poses are kept).
+  double new_map_after_lost_s = 1.0;
+  // Marker initialisation: when the initialisation reference and the current frame both
+  // have a usable marker location with centres at least this far apart (metres), the
+  // matches are triangulated with the markers' relative pose and the map starts in the world.
+  double min_marker_init_baseline_m = 0.5;
+  // ... and at least this median parallax of the triangulated points (degrees).
+  double min_marker_init_parallax_deg = 1.0;
 
   bool Check() const;
 };
@@ -113,6 +122,9 @@ struct SystemStats {
   int num_marker_only_poses = 0;  // frames whose pose came from markers alone
   int num_world_alignments = 0;
   int num_marker_relocalizations = 0;  // tracking restarted from a marker pose
+  int num_new_maps_after_loss = 0;     // maps started because tracking stayed lost
+  int num_marker_initializations = 0;  // maps initialised from two marker locations
+  int num_maps_discarded = 0;          // closed maps never aligned (marker map only)
 };
 
 struct StampedPose {
@@ -138,8 +150,11 @@ class System {
   void Finish();
 
   // Every frame that got a pose, re-expressed relative to its reference keyframe's final
-  // pose when that keyframe is still in the map.
+  // pose when that keyframe is still in the map. With a marker map: only poses in the
+  // world (marker poses, aligned maps, closed maps frozen). Keypoints only: the poses of
+  // the map with the most keyframes (maps are in unrelated frames), as ORB-SLAM3 does.
   std::vector<StampedPose> Trajectory() const;
+  // Keyframes and points of the current map plus, with a marker map, of closed aligned maps.
   std::vector<StampedPose> KeyframePoses() const;
   std::vector<Eigen::Vector3d> MapPoints() const;
   const Map& map() const { return *map_; }
@@ -181,6 +196,18 @@ class System {
   void MapKeyframe(KeyframeId keyframe);
   void RecordPose(const Frame& frame, KeyframeId reference);
   void ResetMap();
+  // Recovery and marker initialisation (system_recovery.cc).
+  // Called on a lost frame: true when the loss has lasted new_map_after_lost_s.
+  bool LostTooLong(const Frame& frame);
+  // Keeps what must outlive the current map before it is discarded (ResetMap).
+  void CloseMap();
+  // Builds the initial map from the marker poses of the reference and `frame` directly in
+  // the world; false when the marker poses do not allow it (the caller initialises as usual).
+  bool InitializeFromMarkers(Frame& frame, FrameReport& report);
+  void FinishInitialization(Frame& first, Frame& frame, KeyframeId first_id,
+                            KeyframeId second_id, int num_points, FrameReport& report);
+  // Poses of the current map in its own frame (reference keyframes' final poses).
+  std::vector<StampedPose> CurrentMapPoses(bool world_only) const;
   void StartMappingThread();
   void StopMappingThread();
   bool MapperIdle() const;
@@ -206,6 +233,13 @@ class System {
   bool world_aligned_ = false;
   int next_alignment_anchors_ = 0;  // alignment is tried again at this many anchors
   int lost_with_markers_ = 0;
+  std::optional<double> lost_since_s_;  // timestamp of the first lost frame of this loss
+  // Closed maps: keypoints only, the biggest one's poses; with markers, the aligned ones'
+  // keyframes and points (their poses stay in poses_, frozen).
+  std::vector<StampedPose> biggest_closed_poses_;
+  std::size_t biggest_closed_keyframes_ = 0;
+  std::vector<StampedPose> closed_keyframes_;
+  std::vector<Eigen::Vector3d> closed_points_;
   double detection_ms_ = 0.0;  // marker detection time of the current image
 
   std::unique_ptr<BoundedQueue<KeyframeId>> queue_;
