@@ -25,6 +25,7 @@ struct Scenario {
   int blackout_end = 60;
   bool markers = false;          // a marker map is given
   int markers_until = 1 << 30;   // markers are detected only before this frame
+  double marker_size = 0.4;      // m
 };
 
 struct ScenarioRun {
@@ -42,7 +43,7 @@ ScenarioRun RunScenario(const Scenario& scenario) {
   // The synthetic scene gives few keyframes: without this a lost map would be "young" and
   // simply reset, not closed after new_map_after_lost_s.
   options.reset_max_keyframes = 0;
-  if (scenario.markers) options.marker_map = SceneMarkers();
+  if (scenario.markers) options.marker_map = SceneMarkers(11, scenario.marker_size);
   System system(camera, options);
   std::mt19937 rng(7);
   ScenarioRun run;
@@ -151,6 +152,20 @@ TEST(SystemRecovery, MapNeverAlignedStaysOutOfTheWorldTrajectory) {
   EXPECT_GE(static_cast<int>(run.trajectory.size()), scenario.blackout_begin);
   EXPECT_FALSE(run.keyframes.empty());  // the closed aligned map's keyframes are kept
   EXPECT_LT(SceneAbsoluteRmse(run.trajectory), 0.02);
+}
+
+TEST(SystemRecovery, FarMarkersGiveNoLocation) {
+  Scenario scenario;
+  scenario.num_frames = 30;
+  scenario.blackout_begin = scenario.blackout_end = 0;
+  scenario.markers = true;
+  scenario.marker_size = 0.1;  // 3 m away: 30 sides, beyond max_marker_distance_sides
+  const ScenarioRun far = RunScenario(scenario);
+  EXPECT_EQ(far.stats.num_marker_frames, 0);
+  EXPECT_TRUE(far.trajectory.empty());  // the keypoint map is never put in the world
+  scenario.marker_size = 0.2;  // 15 sides
+  const ScenarioRun near = RunScenario(scenario);
+  EXPECT_GT(near.stats.num_marker_frames, 20);
 }
 
 }  // namespace

@@ -36,15 +36,15 @@ inline int SceneFrameOf(double timestamp_s) {
   return static_cast<int>(std::lround(timestamp_s / kSceneDt));
 }
 
-// A row of 0.4 m markers, 0.5 m apart, on a wall 3 m in front of the start.
-inline MarkerMap SceneMarkers(int count = 11) {
+// A row of markers (sides `size`, 0.5 m apart) on a wall 3 m in front of the start.
+inline MarkerMap SceneMarkers(int count = 11, double size = 0.4) {
   MarkerMap map;
   map.dictionary = "DICT_4X4_50";
   const Eigen::Quaterniond facing(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()));
   for (int i = 0; i < count; ++i) {
     MarkerInfo info;
     info.id = i;
-    info.size = 0.4;
+    info.size = size;
     info.world_from_marker = Rigid3(facing, Eigen::Vector3d(-1.0 + 0.5 * i, 0.0, 3.0));
     map.markers[i] = info;
   }
