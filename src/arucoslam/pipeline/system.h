@@ -65,7 +65,7 @@ struct SystemOptions {
   // ... and when its nearest marker is at most this many marker sides from the camera: a
   // location's error grows with the square of the distance (default factory, 0.2 m markers:
   // 1-2 cm at 2.5-4.5 m, 5-15 cm at 5-6 m with two markers, decimetres beyond).
-  double max_marker_distance_sides = 20.0;
+  double max_marker_distance_sides = 25.0;
   // World alignment waits for this many keyframes with a usable marker location whose
   // camera centres span at least min_alignment_baseline_m (metres); it is refused when the
   // anchors' residual after alignment exceeds max_alignment_rms_m (metres).

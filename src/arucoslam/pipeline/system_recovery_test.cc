@@ -159,7 +159,7 @@ TEST(SystemRecovery, FarMarkersGiveNoLocation) {
   scenario.num_frames = 30;
   scenario.blackout_begin = scenario.blackout_end = 0;
   scenario.markers = true;
-  scenario.marker_size = 0.1;  // 3 m away: 30 sides, beyond max_marker_distance_sides
+  scenario.marker_size = 0.1;  // 3 m away: 30 sides, beyond max_marker_distance_sides (25)
   const ScenarioRun far = RunScenario(scenario);
   EXPECT_EQ(far.stats.num_marker_frames, 0);
   EXPECT_TRUE(far.trajectory.empty());  // the keypoint map is never put in the world
