@@ -7,6 +7,7 @@
 #include "arucoslam/exe/experiments_report.h"
 #include "arucoslam/exe/marker_only_run.h"
 #include "arucoslam/exe/slam_run.h"
+#include "arucoslam/eval/world_surfaces.h"
 #include "arucoslam/io/dataset_reader.h"
 #include "arucoslam/io/marker_map_json.h"
 #include "arucoslam/io/path_json.h"
@@ -62,6 +63,20 @@ void Evaluate(const Trajectory& gt, const Trajectory& est, bool with_sim3, Exper
   if (with_sim3) run.sim3 = EvaluateTrajectory(gt, est, run.label, run.label, Sim3Options());
 }
 
+// A SLAM run's counts, keyframes and map accuracy (after the alignment of `evaluation`,
+// against the surfaces of the sequence's world.sdf when it has one).
+void AddSlamResults(const SlamRunResult& result, const fs::path& sequence,
+                    const std::optional<TrajectoryEvaluation>& evaluation, ExperimentRun& run) {
+  run.losses = result.stats.losses;
+  run.new_maps = result.timing.num_new_maps_after_loss;
+  run.keyframes = static_cast<int>(result.keyframes.size());
+  run.keyframe_poses = result.keyframes;
+  const fs::path world = sequence / "world.sdf";
+  if (!evaluation || result.map_points.empty() || !fs::exists(world)) return;
+  run.map_accuracy = ComputeMapAccuracy(result.map_points, evaluation->alignment.gt_from_est,
+                                        LoadWorldSurfaces(world), MapAccuracyOptions{});
+}
+
 ExperimentRun MarkerOnlyRun(const fs::path& sequence, const fs::path& out_dir, bool progress) {
   ExperimentRun run;
   run.label = "markers only (no SLAM)";
@@ -106,11 +121,15 @@ ExperimentRun MarkerSlamRun(const fs::path& sequence, const fs::path& out_dir, b
   run.median_frame_ms = result.timing.frame_ms.Summarize().median;
   run.note = fmt::format(
       "{} of {} frames with a pose ({} from markers alone), {} losses, {} marker "
-      "relocalisations, {} world alignments, {} keyframes, {} map points",
+      "relocalisations, {} world alignments ({} maps initialised from markers), {} new maps "
+      "after a loss ({} never aligned, left out), {} keyframes, {} map points in the last map",
       result.stats.frames_tracked, result.stats.frames, result.timing.num_marker_only_poses,
       result.stats.losses, result.timing.num_marker_relocalizations,
-      result.timing.num_world_alignments, result.stats.keyframes, result.stats.map_points);
+      result.timing.num_world_alignments, result.timing.num_marker_initializations,
+      result.timing.num_new_maps_after_loss, result.timing.num_maps_discarded,
+      result.stats.keyframes, result.stats.map_points);
   Evaluate(dataset.ground_truth(), result.trajectory, /*with_sim3=*/true, run);
+  AddSlamResults(result, sequence, run.absolute, run);
   return run;
 }
 
@@ -128,10 +147,14 @@ ExperimentRun KeypointSlamRun(const std::string& label, const std::string& seque
       RunSlamOnDataset(dataset, sequence.string(), options, /*markers=*/false, out_dir, progress);
   run.available = true;
   run.median_frame_ms = result.timing.frame_ms.Summarize().median;
-  run.note = fmt::format("{} of {} frames tracked, {} losses, {} keyframes, {} map points",
-                         result.stats.frames_tracked, result.stats.frames, result.stats.losses,
-                         result.stats.keyframes, result.stats.map_points);
+  run.note = fmt::format(
+      "{} of {} frames tracked, {} losses, {} new maps after a loss (the output is the map "
+      "with the most keyframes), {} keyframes, {} map points in the last map",
+      result.stats.frames_tracked, result.stats.frames, result.stats.losses,
+      result.timing.num_new_maps_after_loss, result.stats.keyframes, result.stats.map_points);
   Evaluate(dataset.ground_truth(), result.trajectory, /*with_sim3=*/true, run);
+  run.in_world_frame = false;
+  AddSlamResults(result, sequence, run.sim3, run);
   return run;
 }
 
@@ -173,7 +196,8 @@ ExperimentsResult RunExperiments(const ExperimentsOptions& options) {
 
   const Dataset reference = Dataset::Open(with_markers);
   result.table = FormatExperimentsTable(result.runs);
-  WriteExperimentsReport(reference.ground_truth(), result.runs, result.table, staged.path());
+  WriteExperimentsReport(reference.ground_truth(), result.runs, result.table, staged.path(),
+                         with_markers / "world.sdf");
   staged.Commit();
   return result;
 }

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "arucoslam/eval/evaluation.h"
+#include "arucoslam/eval/map_accuracy.h"
 #include "arucoslam/sim/dataset_writer.h"
 
 namespace arucoslam {
@@ -20,7 +21,7 @@ struct ExperimentsOptions {
   std::optional<std::filesystem::path> world_without_markers_dir;
   std::filesystem::path out_dir;
   double max_seconds = 0.0;  // render only the first seconds of the route (0: all)
-  DatasetWriterOptions render;
+  DatasetWriterOptions render = DefaultSensorOptions();  // the sensor of `simulate`
   bool progress = true;
 
   bool Check() const { return max_seconds >= 0.0 && render.Check(); }
@@ -35,6 +36,16 @@ struct ExperimentRun {
   std::optional<TrajectoryEvaluation> absolute;  // no alignment (world frame)
   std::optional<TrajectoryEvaluation> sim3;      // Sim(3)-aligned (keypoint-only runs)
   double median_frame_ms = 0.0;                  // per-frame processing time
+  // SLAM runs only (-1 / empty otherwise), from the System.
+  int losses = -1;          // transitions tracking -> lost
+  int new_maps = -1;        // maps started after a long loss
+  int keyframes = -1;       // keyframes output (keyframes.tum)
+  Trajectory keyframe_poses;
+  // Distance of the output map points to the nearest surface of the true world, after the
+  // alignment of the evaluation shown for the run (world frame for run 1, Sim(3) for 2, 3).
+  std::optional<MapAccuracy> map_accuracy;
+  // The run's poses are in the world frame (markers); false: plots use the Sim(3) fit.
+  bool in_world_frame = true;
 };
 
 struct ExperimentsResult {

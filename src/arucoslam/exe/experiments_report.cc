@@ -6,6 +6,7 @@
 #include <functional>
 
 #include "arucoslam/eval/report.h"
+#include "arucoslam/exe/experiments_floor_plan.h"
 #include "arucoslam/util/files.h"
 
 namespace arucoslam {
@@ -20,6 +21,13 @@ struct Row {
   std::string name;
   RunValue value;
 };
+
+// A SLAM count of the run, "-" for runs that have none.
+RunValue Count(int ExperimentRun::*field) {
+  return [field](const ExperimentRun& run) {
+    return run.*field >= 0 ? std::to_string(run.*field) : std::string("-");
+  };
+}
 
 std::vector<Row> TableRows() {
   const auto absolute = [](auto getter) {
@@ -36,6 +44,9 @@ std::vector<Row> TableRows() {
        })},
       {"longest gap (s)",
        absolute([](const TrajectoryEvaluation& e) { return fmt::format("{:.2f}", e.completeness.longest_gap); })},
+      {"tracking losses", Count(&ExperimentRun::losses)},
+      {"new maps after a loss", Count(&ExperimentRun::new_maps)},
+      {"keyframes", Count(&ExperimentRun::keyframes)},
       {"ATE world frame RMSE (m)",
        absolute([](const TrajectoryEvaluation& e) { return Metres(e.ape_translation.rmse); })},
       {"ATE world frame max (m)",
@@ -51,6 +62,20 @@ std::vector<Row> TableRows() {
       {"mean |error| z (m)", absolute([](const TrajectoryEvaluation& e) { return Metres(e.per_axis.mean_abs.z()); })},
       {"rotation error RMSE (deg)",
        absolute([](const TrajectoryEvaluation& e) { return fmt::format("{:.3f}", e.ape_rotation_deg.rmse); })},
+      {"map points (as evaluated)",
+       [](const ExperimentRun& run) {
+         return run.map_accuracy ? std::to_string(run.map_accuracy->num_points) : std::string("-");
+       }},
+      {"map point to surface, median (m)",
+       [](const ExperimentRun& run) {
+         return run.map_accuracy ? Metres(run.map_accuracy->median) : std::string("-");
+       }},
+      {"map points within 5 cm of a surface",
+       [](const ExperimentRun& run) {
+         return run.map_accuracy
+                    ? fmt::format("{:.1f}%", 100.0 * run.map_accuracy->fraction_within)
+                    : std::string("-");
+       }},
       {"median time per frame (ms)",
        [](const ExperimentRun& run) {
          return run.available ? fmt::format("{:.1f}", run.median_frame_ms) : std::string("-");
@@ -150,7 +175,8 @@ std::string FormatExperimentsTable(const std::vector<ExperimentRun>& runs) {
 }
 
 void WriteExperimentsReport(const Trajectory& ground_truth, const std::vector<ExperimentRun>& runs,
-                            const std::string& table, const std::filesystem::path& dir) {
+                            const std::string& table, const std::filesystem::path& dir,
+                            const std::optional<std::filesystem::path>& world_sdf) {
   WriteTextFileAtomically(dir / "table.txt", table);
   std::vector<TrajectoryEvaluation> absolute;
   std::vector<TrajectoryEvaluation> aligned;
@@ -168,6 +194,10 @@ void WriteExperimentsReport(const Trajectory& ground_truth, const std::vector<Ex
       plot_files.push_back(prefix + name);
     }
   };
+  if (world_sdf) {
+    WriteTextFileAtomically(dir / "floor_plan.svg", FloorPlanSvg(*world_sdf, ground_truth, runs));
+    plot_files.push_back("floor_plan.svg");
+  }
   write_plots(absolute, "world_");
   write_plots(aligned, "sim3_aligned_");
   std::string markdown = "# ArucoSLAM experiments\n\n" + MarkdownTable(runs) + "\n## Runs\n\n" +

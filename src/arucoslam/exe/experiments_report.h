@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -11,8 +12,10 @@
 
 namespace arucoslam {
 
-// Writes table.txt, plots (*.svg), report.md and report.html into `dir`.
+// Writes table.txt, plots (*.svg), report.md and report.html into `dir`; with a world file
+// also floor_plan.svg (the runs over the world's plan).
 void WriteExperimentsReport(const Trajectory& ground_truth, const std::vector<ExperimentRun>& runs,
-                            const std::string& table, const std::filesystem::path& dir);
+                            const std::string& table, const std::filesystem::path& dir,
+                            const std::optional<std::filesystem::path>& world_sdf = std::nullopt);
 
 }  // namespace arucoslam

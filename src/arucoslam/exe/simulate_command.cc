@@ -74,10 +74,7 @@ void RunSimulate(SimulateArgs args) {
 
 void AddSimulateCommand(CLI::App& app, int& exit_status) {
   auto args = std::make_shared<SimulateArgs>();
-  // Realistic sensor defaults: a little noise, slight exposure drift, short motion blur.
-  args->writer.render.noise_sigma = 2.0;
-  args->writer.render.exposure_variation = 0.08;
-  args->writer.exposure_time_s = 0.0;
+  args->writer = DefaultSensorOptions();  // the experiments' sensor
   CLI::App* simulate = app.add_subcommand(
       "simulate", "Render a sequence along a path through a world: EuRoC layout with ground "
                   "truth, markers.json and world.sdf");

@@ -109,7 +109,8 @@ SlamRunResult RunSlamOnDataset(const Dataset& dataset, const std::string& datase
   result.trajectory = ToTrajectory(system.Trajectory());
   result.keyframes = ToTrajectory(system.KeyframePoses());
   result.timing = system.Stats();
-  WriteSlamOutput(staged.path(), result.trajectory, result.keyframes, system.MapPoints(),
+  result.map_points = system.MapPoints();
+  WriteSlamOutput(staged.path(), result.trajectory, result.keyframes, result.map_points,
                   result.stats);
   if (!reuse.save.empty()) {
     MapFileInfo info;

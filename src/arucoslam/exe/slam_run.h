@@ -34,6 +34,7 @@ struct SlamRunResult {
   Trajectory keyframes;
   SlamRunStats stats;
   SystemStats timing;
+  std::vector<Eigen::Vector3d> map_points;  // as written to map.ply
 };
 
 // `dataset_label` names the dataset in stats.json; `markers` says whether the run used the

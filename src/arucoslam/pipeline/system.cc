@@ -13,10 +13,13 @@ bool SystemOptions::Check() const {
          keyframes.Check() && mapper.Check() && mapper_queue_capacity >= 1 &&
          max_initialization_gap_s > 0.0 && reset_max_keyframes >= 0 && detector.Check() &&
          locator.Check() && alignment.Check() && max_marker_rms_px > 0.0 &&
+         max_marker_distance_sides > 0.0 &&
          min_alignment_anchors >= 2 && min_alignment_baseline_m >= 0.0 &&
          max_alignment_rms_m > 0.0 && marker_reset_lost_frames >= 1 &&
          max_realignment_anchors >= min_alignment_anchors && places.Check() &&
-         marker_mapping.Check();
+         max_marker_disagreement_m > 0.0 && min_frames_between_anchor_keyframes >= 0 &&
+         marker_mapping.Check() && new_map_after_lost_s > 0.0 &&
+         min_marker_init_baseline_m > 0.0 && min_marker_init_parallax_deg >= 0.0;
 }
 
 System::System(const CameraModel& camera, const SystemOptions& options)
@@ -28,6 +31,7 @@ System::System(const CameraModel& camera, const SystemOptions& options)
   map_ = std::make_unique<Map>();
   tracker_ = std::make_unique<Tracker>(*map_, options_.tracker);
   mapper_ = std::make_unique<LocalMapper>(*map_, options_.mapper);
+  GuardMarkerKeyframes();
   if (options_.marker_map) detector_ = std::make_unique<MarkerDetector>(options_.detector);
   MakePlaceRecognition();
   StartMappingThread();
@@ -162,6 +166,7 @@ void System::Initialize(Frame& frame, FrameReport& report) {
     std::lock_guard lock(stats_mutex_);
     ++stats_.num_initialization_attempts;
   }
+  if (InitializeFromMarkers(frame, report)) return;
   const InitializationResult result =
       initializer_.Initialize(init_reference_->features, frame.features, camera_);
   report.message = result.message;
@@ -182,9 +187,14 @@ void System::Initialize(Frame& frame, FrameReport& report) {
     report.message = created.message;
     return;
   }
+  FinishInitialization(first, frame, created.first, created.second, created.num_points, report);
+}
+
+void System::FinishInitialization(Frame& first, Frame& frame, KeyframeId first_id,
+                                  KeyframeId second_id, int num_points, FrameReport& report) {
   init_reference_.reset();
-  tracker_->Start(frame, created.second);
-  RecordPose(first, created.first);
+  tracker_->Start(frame, second_id);
+  RecordPose(first, first_id);
   // The reference frame may have got a marker-only pose when it was seen: that entry is
   // replaced in place (the order of poses_ stays the order of time).
   for (std::size_t i = 0; i + 1 < poses_.size(); ++i) {
@@ -194,13 +204,13 @@ void System::Initialize(Frame& frame, FrameReport& report) {
       break;
     }
   }
-  RecordPose(frame, created.second);
+  RecordPose(frame, second_id);
   if (places_) {
-    places_->KeyframeMapped(created.first);
-    places_->KeyframeMapped(created.second);
+    places_->KeyframeMapped(first_id);
+    places_->KeyframeMapped(second_id);
   }
-  AddAnchor(created.first, init_reference_fix_);
-  AddAnchor(created.second, fix_);
+  AddAnchor(first_id, init_reference_fix_);
+  AddAnchor(second_id, fix_);
   init_reference_fix_.reset();
   MaybeAlignWorld(&frame);
   frames_since_keyframe_ = 0;
@@ -209,8 +219,8 @@ void System::Initialize(Frame& frame, FrameReport& report) {
   report.cam_from_world = frame.cam_from_world;
   report.initialized_map = true;
   report.new_keyframe = true;
-  report.num_inliers = created.num_points;
-  report.message = "map initialised with " + std::to_string(created.num_points) + " points";
+  report.num_inliers = num_points;
+  report.message = "map initialised with " + std::to_string(num_points) + " points";
   std::lock_guard lock(stats_mutex_);
   ++stats_.num_initializations;
   stats_.num_keyframes_inserted += 2;
@@ -220,6 +230,18 @@ void System::Track(Frame& frame, FrameReport& report) {
   static const std::vector<MarkerPoseObservation> kNoMarkers;
   FollowMapCorrections();
   TrackingResult result = tracker_->Track(frame, world_aligned_ && fix_ ? fix_->markers : kNoMarkers);
+  if (result.state == TrackingState::kTracking && frame.cam_from_world &&
+      DisagreesWithMarkers(*frame.cam_from_world)) {
+    ARUCOSLAM_LOG_DEBUG("frame {}: keypoint pose {:.2f} m from the markers' location, rejected",
+                        report.index,
+                        (frame.cam_from_world->Inverse().translation -
+                         fix_->world_from_cam.translation).norm());
+    tracker_->MarkLost();
+    frame.cam_from_world.reset();
+    result.state = TrackingState::kLost;
+    std::lock_guard lock(stats_mutex_);
+    ++stats_.num_marker_disagreements;
+  }
   if (result.state != TrackingState::kTracking &&
       (RelocalizeWithMarkers(frame, report) || RelocalizeWithPlaces(frame, report) ||
        RelocalizeInLoadedMap(frame, report))) {
@@ -241,13 +263,24 @@ void System::Track(Frame& frame, FrameReport& report) {
     // keep coming and it does not take them back.
     const bool stuck = fix_ && ++lost_with_markers_ >= options_.marker_reset_lost_frames;
     const bool young = static_cast<int>(map_->NumKeyframes()) <= options_.reset_max_keyframes;
-    if (!map_loaded_ && (stuck || (young && !world_aligned_))) {
+    if (map_loaded_) {
+      // A loaded map is kept: frames relocalise into it.
+    } else if (LostTooLong(frame)) {
+      ARUCOSLAM_LOG_DEBUG("frame {}: lost for {:.1f} s, starting a new map", report.index,
+                          options_.new_map_after_lost_s);
+      {
+        std::lock_guard lock(stats_mutex_);
+        ++stats_.num_new_maps_after_loss;
+      }
+      ResetMap();
+    } else if (stuck || (young && !world_aligned_)) {
       ResetMap();
     }
     return;
   }
   last_state_ = TrackingState::kTracking;
   lost_with_markers_ = 0;
+  lost_since_s_.reset();
   ++frames_since_keyframe_;
   MaybeInsertKeyframe(frame, result.num_inliers, report);
   report.cam_from_world = frame.cam_from_world;
@@ -266,7 +299,13 @@ void System::MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& rep
   });
   input.mapper_idle = MapperIdle();
   input.mapper_has_room = options_.blocking || queue_->Size() < queue_->capacity();
-  if (!DecideKeyframe(options_.keyframes, input).insert) return;
+  // A frame with a usable marker location becomes a keyframe sooner until the map is first
+  // aligned (anchors are kept on keyframes only).
+  const bool wants_anchor =
+      fix_ && !world_aligned_ &&
+      frames_since_keyframe_ >= options_.min_frames_between_anchor_keyframes &&
+      num_inliers > options_.keyframes.min_tracked_points && input.mapper_has_room;
+  if (!wants_anchor && !DecideKeyframe(options_.keyframes, input).insert) return;
   const KeyframeId keyframe = InsertKeyframe(*map_, frame, tracker_->reference_keyframe());
   tracker_->SetReferenceKeyframe(keyframe);
   frames_since_keyframe_ = 0;
@@ -303,6 +342,7 @@ void System::RecordPose(const Frame& frame, KeyframeId reference) {
 
 void System::ResetMap() {
   StopMappingThread();
+  CloseMap();
   // Poses already in the world frame stay, frozen at their current estimate.
   std::vector<TrackedPose> kept;
   map_->Read([&](const MapData& data) {
@@ -322,6 +362,7 @@ void System::ResetMap() {
   map_ = std::make_unique<Map>();
   tracker_ = std::make_unique<Tracker>(*map_, options_.tracker);
   mapper_ = std::make_unique<LocalMapper>(*map_, options_.mapper);
+  GuardMarkerKeyframes();
   MakePlaceRecognition();
   ResetMarkerMapping();
   poses_ = std::move(kept);
@@ -331,6 +372,7 @@ void System::ResetMap() {
   next_alignment_anchors_ = 0;
   world_aligned_ = false;
   lost_with_markers_ = 0;
+  lost_since_s_.reset();
   last_state_ = TrackingState::kNotInitialized;
   mapping_busy_ = false;
   StartMappingThread();
@@ -339,9 +381,16 @@ void System::ResetMap() {
 }
 
 std::vector<StampedPose> System::Trajectory() const {
+  if (options_.marker_map) return CurrentMapPoses(/*world_only=*/true);
+  if (map_->NumKeyframes() >= biggest_closed_keyframes_) return CurrentMapPoses(false);
+  return biggest_closed_poses_;
+}
+
+std::vector<StampedPose> System::CurrentMapPoses(bool world_only) const {
   std::vector<StampedPose> trajectory;
   map_->Read([&](const MapData& data) {
     for (const TrackedPose& pose : poses_) {
+      if (world_only && !pose.in_world) continue;
       const Keyframe* reference = data.FindKeyframe(pose.reference);
       const Rigid3 cam_from_world =
           reference ? pose.cam_from_reference * reference->cam_from_world : pose.cam_from_world;
@@ -353,21 +402,25 @@ std::vector<StampedPose> System::Trajectory() const {
 }
 
 std::vector<StampedPose> System::KeyframePoses() const {
-  return map_->Read([](const MapData& data) {
-    std::vector<StampedPose> poses;
+  std::vector<StampedPose> poses = closed_keyframes_;
+  if (options_.marker_map && !world_aligned_) return poses;  // not in the world frame
+  map_->Read([&](const MapData& data) {
     for (const auto& [id, keyframe] : data.keyframes()) {
       poses.push_back({keyframe.timestamp_s, keyframe.cam_from_world.Inverse()});
     }
-    return poses;
+    return 0;
   });
+  return poses;
 }
 
 std::vector<Eigen::Vector3d> System::MapPoints() const {
-  return map_->Read([](const MapData& data) {
-    std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector3d> points = closed_points_;
+  if (options_.marker_map && !world_aligned_) return points;  // not in the world frame
+  map_->Read([&](const MapData& data) {
     for (const auto& [id, point] : data.map_points()) points.push_back(point.p_in_world);
-    return points;
+    return 0;
   });
+  return points;
 }
 
 SystemStats System::Stats() const {

@@ -65,6 +65,10 @@ struct SystemOptions {
   // A marker location is used only when it is not ambiguous (several markers, or one whose
   // IPPE solutions are well separated) and its corner RMS is at most this, pixels.
   double max_marker_rms_px = 2.0;
+  // ... and when its nearest marker is at most this many marker sides from the camera: a
+  // location's error grows with the square of the distance (default factory, 0.2 m markers:
+  // 1-2 cm at 2.5-4.5 m, 5-15 cm at 5-6 m with two markers, decimetres beyond).
+  double max_marker_distance_sides = 25.0;
   // World alignment waits for this many keyframes with a usable marker location whose
   // camera centres span at least min_alignment_baseline_m (metres); it is refused when the
   // anchors' residual after alignment exceeds max_alignment_rms_m (metres).
@@ -74,16 +78,25 @@ struct SystemOptions {
   // After the first alignment, anchors keep being collected and the map is aligned again
   // (a small Sim3 correction) each time their number doubles, up to this many anchors.
   int max_realignment_anchors = 64;
+  // Until the first alignment, a frame with a usable marker location becomes a keyframe when
+  // at least this many frames passed since the last keyframe.
+  int min_frames_between_anchor_keyframes = 2;
   // Aligned map, tracking lost for this many frames in a row while markers give poses but
   // the map does not take them back: the map is discarded and a new one initialised and
   // aligned (the poses already output are kept).
   int marker_reset_lost_frames = 10;
+  // World-aligned map: a keypoint pose whose camera centre lies farther than this (metres)
+  // from the same frame's marker location is wrong (a look-alike place): tracking counts as
+  // lost and restarts from the markers. A place-database relocalisation is accepted only when
+  // a marker location of the frame agrees with it this closely.
+  double max_marker_disagreement_m = 0.5;
   // Once the map is world-aligned, keyframes' marker observations join local BA (known
   // markers fixed) and markers the map lacks are mapped (system_marker_mapping.cc).
   bool markers_in_local_ba = true;
   bool map_unknown_markers = true;
-  // Finish runs one bundle adjustment of the whole aligned map with every marker
-  // observation (known markers fixed); otherwise only the mapped markers are refined.
+  // When markers were mapped, Finish runs one bundle adjustment of the whole aligned map with
+  // every marker observation (known markers fixed); otherwise only the mapped markers are
+  // refined.
   bool final_marker_bundle_adjustment = true;
   // Mapped markers seen by at least this many keyframes locate frames like known ones
   // (marker poses and relocalisation where the known map has no marker). 0: never.
@@ -94,6 +107,15 @@ struct SystemOptions {
   // relocalised from it and, with places.loop_closing, loops are closed. Null: neither.
   std::shared_ptr<const Vocabulary> vocabulary;
   PlaceRecognitionOptions places;
+  // Tracking lost for this long (seconds) and not relocalised: a new map is started (the
+  // old one is closed; see System::Trajectory for which poses are kept).
+  double new_map_after_lost_s = 1.0;
+  // Marker initialisation: when the initialisation reference and the current frame both
+  // have a usable marker location with centres at least this far apart (metres), the
+  // matches are triangulated with the markers' relative pose and the map starts in the world.
+  double min_marker_init_baseline_m = 0.5;
+  // ... and at least this median parallax of the triangulated points (degrees).
+  double min_marker_init_parallax_deg = 1.0;
 
   bool Check() const;
 };
@@ -132,8 +154,12 @@ struct SystemStats {
   int num_marker_only_poses = 0;  // frames whose pose came from markers alone
   int num_world_alignments = 0;
   int num_marker_relocalizations = 0;  // tracking restarted from a marker pose
+  int num_marker_disagreements = 0;    // keypoint poses rejected by the markers
   int num_map_relocalizations = 0;     // loaded map: restarted from a keyframe match
   PlaceRecognitionStats places;        // relocalisation and loops (with a vocabulary)
+  int num_new_maps_after_loss = 0;     // maps started because tracking stayed lost
+  int num_marker_initializations = 0;  // maps initialised from two marker locations
+  int num_maps_discarded = 0;          // closed maps never aligned (marker map only)
 };
 
 struct StampedPose {
@@ -166,8 +192,11 @@ class System {
   void Finish();
 
   // Every frame that got a pose, re-expressed relative to its reference keyframe's final
-  // pose when that keyframe is still in the map.
+  // pose when that keyframe is still in the map. With a marker map: only poses in the
+  // world (marker poses, aligned maps, closed maps frozen). Keypoints only: the poses of
+  // the map with the most keyframes (maps are in unrelated frames), as ORB-SLAM3 does.
   std::vector<StampedPose> Trajectory() const;
+  // Keyframes and points of the current map plus, with a marker map, of closed aligned maps.
   std::vector<StampedPose> KeyframePoses() const;
   std::vector<Eigen::Vector3d> MapPoints() const;
   const Map& map() const { return *map_; }
@@ -203,6 +232,8 @@ class System {
                                              const std::vector<MarkerDetection>& detections,
                                              FrameReport& report);
   bool RelocalizeWithMarkers(Frame& frame, FrameReport& report);
+  // True when the frame's marker location (world-aligned map) contradicts the pose.
+  bool DisagreesWithMarkers(const Rigid3& cam_from_world) const;
   // Map reuse (system_map_reuse.cc): a frame before the first localisation in a loaded map,
   // and the keyframe-seeded relocalisation (brute-force matching against a few keyframes
   // per frame, pose-only optimisation, then TrackFromPose).
@@ -222,6 +253,9 @@ class System {
   // culled to the keyframe nearest in time, so that later corrections move them too.
   void FollowMapCorrections();
   void ReanchorOrphanPoses();
+  // The map was moved as a whole (world alignment): the cached keyframe poses that
+  // ReanchorOrphanPoses compares against are re-read.
+  void RefreshKeyframePoseCache();
   // Held while the map is moved from outside (world alignment); empty without places.
   std::unique_lock<std::mutex> LockPlacesForMapMove();
   // Marker mapping (system_marker_mapping.cc). Start: on each world alignment, with the
@@ -243,6 +277,18 @@ class System {
   void MapKeyframe(KeyframeId keyframe);
   void RecordPose(const Frame& frame, KeyframeId reference);
   void ResetMap();
+  // Recovery and marker initialisation (system_recovery.cc).
+  // Called on a lost frame: true when the loss has lasted new_map_after_lost_s.
+  bool LostTooLong(const Frame& frame);
+  // Keeps what must outlive the current map before it is discarded (ResetMap).
+  void CloseMap();
+  // Builds the initial map from the marker poses of the reference and `frame` directly in
+  // the world; false when the marker poses do not allow it (the caller initialises as usual).
+  bool InitializeFromMarkers(Frame& frame, FrameReport& report);
+  void FinishInitialization(Frame& first, Frame& frame, KeyframeId first_id,
+                            KeyframeId second_id, int num_points, FrameReport& report);
+  // Poses of the current map in its own frame (reference keyframes' final poses).
+  std::vector<StampedPose> CurrentMapPoses(bool world_only) const;
   void StartMappingThread();
   void StopMappingThread();
   bool MapperIdle() const;
@@ -266,8 +312,19 @@ class System {
   std::optional<MarkerFix> init_reference_fix_;
   std::vector<MarkerAnchor> anchors_;
   bool world_aligned_ = false;
+  // Until the map is aligned, keyframes that saw a marker are not culled: they carry the
+  // alignment's anchors (read by the mapping thread's keyframe culling).
+  std::atomic<bool> keep_marker_keyframes_{true};
+  void GuardMarkerKeyframes();
   int next_alignment_anchors_ = 0;  // alignment is tried again at this many anchors
   int lost_with_markers_ = 0;
+  std::optional<double> lost_since_s_;  // timestamp of the first lost frame of this loss
+  // Closed maps: keypoints only, the biggest one's poses; with markers, the aligned ones'
+  // keyframes and points (their poses stay in poses_, frozen).
+  std::vector<StampedPose> biggest_closed_poses_;
+  std::size_t biggest_closed_keyframes_ = 0;
+  std::vector<StampedPose> closed_keyframes_;
+  std::vector<Eigen::Vector3d> closed_points_;
   double detection_ms_ = 0.0;  // marker detection time of the current image
   // Markers of the world-aligned map; only the mapping thread touches it while it runs.
   std::unique_ptr<MarkerMapper> marker_mapper_;

@@ -1,6 +1,7 @@
 // System's marker handling: locating each frame in the known marker map, marker-only poses,
 // relocalisation from a marker pose, and the Sim(3) alignment of the keypoint map to the world.
 #include <algorithm>
+#include <limits>
 #include <utility>
 
 #include "arucoslam/pipeline/system.h"
@@ -26,6 +27,18 @@ double Baseline(const std::vector<WorldAnchor>& anchors) {
   return baseline;
 }
 
+// Distance from the camera to its nearest located marker, in that marker's sides.
+double NearestMarkerInSides(const CameraLocation& location, const MarkerMap& known) {
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const int id : location.marker_ids) {
+    const MarkerInfo* info = known.Find(id);
+    const double distance =
+        (info->world_from_marker.translation - location.world_from_cam.translation).norm();
+    nearest = std::min(nearest, distance / info->size);
+  }
+  return nearest;
+}
+
 }  // namespace
 
 std::optional<System::MarkerFix> System::LocateWithMarkers(
@@ -42,7 +55,8 @@ std::optional<System::MarkerFix> System::LocateWithMarkers(
   report.num_markers = static_cast<int>(location.marker_ids.size());
   std::optional<MarkerFix> fix;
   if (location.found && !location.quality.ambiguous &&
-      location.quality.reprojection_rms_px <= options_.max_marker_rms_px) {
+      location.quality.reprojection_rms_px <= options_.max_marker_rms_px &&
+      NearestMarkerInSides(location, known) <= options_.max_marker_distance_sides) {
     fix.emplace();
     fix->world_from_cam = location.world_from_cam;
     for (const MarkerDetection& detection : detections) {
@@ -65,6 +79,20 @@ std::optional<System::MarkerFix> System::LocateWithMarkers(
   detection_ms_ = 0.0;
   if (fix) ++stats_.num_marker_frames;
   return fix;
+}
+
+void System::GuardMarkerKeyframes() {
+  if (!options_.marker_map) return;
+  keep_marker_keyframes_ = true;
+  mapper_->SetKeyframeGuard([this](const Keyframe& keyframe) {
+    return keep_marker_keyframes_ && !keyframe.markers.empty();
+  });
+}
+
+bool System::DisagreesWithMarkers(const Rigid3& cam_from_world) const {
+  if (!world_aligned_ || !fix_) return false;
+  const Eigen::Vector3d centre = cam_from_world.Inverse().translation;
+  return (centre - fix_->world_from_cam.translation).norm() > options_.max_marker_disagreement_m;
 }
 
 bool System::RelocalizeWithMarkers(Frame& frame, FrameReport& report) {
@@ -148,6 +176,8 @@ void System::MaybeAlignWorld(Frame* frame) {
                       world_aligned_ ? "re-" : "", world_from_map.scale, alignment.num_inliers,
                       anchors.size(), alignment.rms_m);
   world_aligned_ = true;
+  keep_marker_keyframes_ = false;
+  RefreshKeyframePoseCache();
   std::lock_guard lock(stats_mutex_);
   ++stats_.num_world_alignments;
 }

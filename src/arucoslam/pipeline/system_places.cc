@@ -20,6 +20,12 @@ bool System::RelocalizeWithPlaces(Frame& frame, FrameReport& report) {
   if (!places_) return false;
   const std::optional<RelocalizationResult> found = places_->Relocalize(frame);
   if (!found) return false;
+  // Look-alike places: in a map aligned to the marker world only a pose that the frame's
+  // markers confirm is taken.
+  if (options_.marker_map && world_aligned_ && (!fix_ || DisagreesWithMarkers(found->cam_from_world))) {
+    ARUCOSLAM_LOG_DEBUG("frame {}: place relocalisation not confirmed by markers", report.index);
+    return false;
+  }
   // The database pose is refined against the local map as after a marker relocalisation.
   const TrackingResult result = tracker_->TrackFromPose(frame, found->cam_from_world);
   if (result.state != TrackingState::kTracking) return false;
@@ -63,6 +69,17 @@ void System::ReanchorOrphanPoses() {
     pose.cam_from_reference = pose.cam_from_world * now.at(anchor).Inverse();
   }
   keyframe_poses_ = std::move(now);
+}
+
+void System::RefreshKeyframePoseCache() {
+  if (!places_) return;
+  keyframe_poses_.clear();
+  map_->Read([&](const MapData& data) {
+    for (const auto& [id, keyframe] : data.keyframes()) {
+      keyframe_poses_.emplace(id, keyframe.cam_from_world);
+    }
+    return 0;
+  });
 }
 
 void System::FollowMapCorrections() {

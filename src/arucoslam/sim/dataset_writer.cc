@@ -104,6 +104,14 @@ bool DatasetWriterOptions::Check() const {
          start_time_ns >= 0;
 }
 
+DatasetWriterOptions DefaultSensorOptions() {
+  DatasetWriterOptions options;
+  options.render.noise_sigma = 2.0;
+  options.render.exposure_variation = 0.08;
+  options.exposure_time_s = 0.0;
+  return options;
+}
+
 std::int64_t TimestampNs(double time_s, std::int64_t start_time_ns) {
   return start_time_ns + static_cast<std::int64_t>(std::llround(time_s * 1e9));
 }

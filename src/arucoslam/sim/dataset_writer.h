@@ -35,6 +35,11 @@ struct DatasetSummary {
   std::string renderer;           // OpenGL platform and renderer used
 };
 
+// The simulated sensor of `simulate` and of `experiments`/`demo` (one default, so that a
+// user's `simulate` + `run` reproduces the experiments): Gaussian noise of 2 grey levels and
+// an exposure that drifts by 8% over 12 s; no motion blur.
+DatasetWriterOptions DefaultSensorOptions();
+
 // Timestamp in nanoseconds of a path time.
 std::int64_t TimestampNs(double time_s, std::int64_t start_time_ns);
 

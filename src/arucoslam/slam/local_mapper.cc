@@ -135,6 +135,7 @@ int LocalMapper::CullRedundantKeyframes(KeyframeId keyframe) {
     for (const KeyframeId& id : candidates) {
       const Keyframe* candidate = data.FindKeyframe(id);
       if (candidate == nullptr ||
+          (keep_ && keep_(*candidate)) ||
           HoldsRareMarkerView(*candidate, markers_, options_.min_marker_keyframes) ||
           !IsRedundant(data, *candidate, options_.redundant_fraction,
                        options_.redundant_observers)) {

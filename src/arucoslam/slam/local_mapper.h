@@ -3,6 +3,8 @@
 // run local bundle adjustment and cull redundant keyframes. pipeline/ runs it on a thread.
 #pragma once
 
+#include <functional>
+
 #include <utility>
 #include <vector>
 
@@ -92,11 +94,15 @@ class LocalMapper {
   // Markers whose observations join local BA (null: none). Used only inside
   // ProcessKeyframe: the caller may change them between calls, not during one.
   void SetMarkerLandmarks(MarkerLandmarks* markers) { markers_ = markers; }
+  // Keyframes for which `keep` returns true are never culled (e.g. those anchoring a pending
+  // world alignment). Set before mapping starts; called on the mapping thread.
+  void SetKeyframeGuard(std::function<bool(const Keyframe&)> keep) { keep_ = std::move(keep); }
 
  private:
   Map& map_;
   LocalMapperOptions options_;
   MarkerLandmarks* markers_ = nullptr;
+  std::function<bool(const Keyframe&)> keep_;
   int num_processed_ = 0;  // keyframes processed so far
   // Points created here, with the value of num_processed_ when they were made.
   std::vector<std::pair<MapPointId, int>> recent_points_;

@@ -156,6 +156,12 @@ bool Tracker::TrackReferenceKeyframe(Frame& frame, TrackingResult& result) {
   return result.num_initial_inliers >= options_.min_pose_inliers;
 }
 
+void Tracker::MarkLost() {
+  state_ = TrackingState::kLost;
+  velocity_.reset();
+  frames_lost_ = options_.recovery_frames + 1;
+}
+
 TrackingResult Tracker::TrackFromPose(Frame& frame, const Rigid3& cam_from_world,
                                       const std::vector<MarkerPoseObservation>& markers) {
   markers_ = &markers;

@@ -76,6 +76,10 @@ class Tracker {
   // Forgets the pose history (state kNotInitialized).
   void Reset();
 
+  // The caller found the last tracked pose wrong (e.g. markers contradict it): tracking
+  // counts as lost and the motion model is dropped.
+  void MarkLost();
+
   // Tracks `frame` (features with `undistorted` filled, camera set). On success fills
   // frame.cam_from_world and frame.map_point_ids (outlier matches removed).
   // `markers`: known (fixed) markers seen in the frame, in the map's world frame; when not

@@ -1,0 +1,172 @@
+#include <gtest/gtest.h>
+
+#include <optional>
+#include <string>
+
+#include "arucoslam/geometry/umeyama.h"
+#include "arucoslam/pipeline/system.h"
+#include "arucoslam/pipeline/system_test_scene.h"
+
+namespace arucoslam {
+namespace {
+
+using test_scene::kSceneDt;
+using test_scene::SceneAbsoluteRmse;
+using test_scene::SceneCamera;
+using test_scene::SceneDetections;
+using test_scene::SceneFrameOf;
+using test_scene::SceneMarkers;
+using test_scene::SceneWorldFromCam;
+
+struct Scenario {
+  // The camera looks past the synthetic cloud's edge after about 120 frames.
+  int num_frames = 110;
+  int blackout_begin = 30;  // frames [begin, end) have no keypoints and no markers
+  int blackout_end = 60;
+  bool markers = false;          // a marker map is given
+  int markers_until = 1 << 30;   // markers are detected only before this frame
+  double marker_size = 0.4;      // m
+};
+
+struct ScenarioRun {
+  std::vector<FrameReport> reports;
+  std::vector<StampedPose> trajectory;
+  std::vector<StampedPose> keyframes;
+  SystemStats stats;
+  std::string invariants;
+};
+
+ScenarioRun RunScenario(const Scenario& scenario) {
+  const CameraModel camera = SceneCamera();
+  SyntheticFeatureScene scene(camera);
+  SystemOptions options;
+  // The synthetic scene gives few keyframes: without this a lost map would be "young" and
+  // simply reset, not closed after new_map_after_lost_s.
+  options.reset_max_keyframes = 0;
+  if (scenario.markers) options.marker_map = SceneMarkers(11, scenario.marker_size);
+  System system(camera, options);
+  std::mt19937 rng(7);
+  ScenarioRun run;
+  std::vector<int> truth;
+  for (int t = 0; t < scenario.num_frames; ++t) {
+    const Rigid3 cam_from_world = SceneWorldFromCam(t).Inverse();
+    Frame frame = scene.MakeFrame(FrameId(t), kSceneDt * t, cam_from_world, &truth);
+    std::vector<MarkerDetection> detections;
+    if (scenario.markers && t < scenario.markers_until) {
+      detections = SceneDetections(*options.marker_map, camera, cam_from_world, rng);
+    }
+    if (t >= scenario.blackout_begin && t < scenario.blackout_end) {
+      frame.features = OrbFeatures();
+      frame.ResetMatches();
+      detections.clear();
+    }
+    run.reports.push_back(system.ProcessFrame(std::move(frame), detections));
+  }
+  system.Finish();
+  run.trajectory = system.Trajectory();
+  run.keyframes = system.KeyframePoses();
+  run.stats = system.Stats();
+  run.invariants = system.map().Read([](const MapData& data) { return data.CheckInvariants(); });
+  return run;
+}
+
+// Position RMSE after the best similarity onto the truth, metres.
+double Sim3AlignedRmse(const std::vector<StampedPose>& trajectory) {
+  std::vector<Eigen::Vector3d> estimated, truth;
+  for (const StampedPose& pose : trajectory) {
+    estimated.push_back(pose.world_from_cam.translation);
+    truth.push_back(SceneWorldFromCam(SceneFrameOf(pose.timestamp_s)).translation);
+  }
+  const std::optional<Sim3> truth_from_estimate =
+      UmeyamaAlignment(estimated, truth, AlignmentKind::kSimilarity);
+  if (!truth_from_estimate) return 1e9;
+  double sum = 0.0;
+  for (std::size_t i = 0; i < estimated.size(); ++i) {
+    sum += ((*truth_from_estimate) * estimated[i] - truth[i]).squaredNorm();
+  }
+  return std::sqrt(sum / estimated.size());
+}
+
+TEST(SystemRecovery, KeypointsOnlyStartsANewMapAfterALongLoss) {
+  const Scenario scenario;  // 2 s blackout once the first map has many keyframes
+  const ScenarioRun run = RunScenario(scenario);
+  EXPECT_EQ(run.stats.num_new_maps_after_loss, 1);
+  EXPECT_EQ(run.stats.num_initializations, 2);
+  EXPECT_EQ(run.invariants, "");
+  // The new map tracks the rest of the route (initialised within half a second).
+  for (int t = scenario.blackout_end + 10; t < scenario.num_frames; ++t) {
+    EXPECT_TRUE(run.reports[t].cam_from_world.has_value()) << t << ": " << run.reports[t].message;
+  }
+  // The output is one map's poses (the maps' frames are unrelated): all on one side of the
+  // blackout, consistent with the truth up to a similarity (1% of the 1.8 m travelled).
+  ASSERT_GT(run.trajectory.size(), 30u);
+  const bool first_map = SceneFrameOf(run.trajectory.front().timestamp_s) < scenario.blackout_begin;
+  for (const StampedPose& pose : run.trajectory) {
+    EXPECT_EQ(SceneFrameOf(pose.timestamp_s) < scenario.blackout_begin, first_map);
+  }
+  EXPECT_LT(Sim3AlignedRmse(run.trajectory), 0.018);
+}
+
+TEST(SystemRecovery, NewMapAfterLossIsInitialisedFromMarkersInTheWorld) {
+  Scenario scenario;
+  scenario.markers = true;
+  const ScenarioRun run = RunScenario(scenario);
+  EXPECT_EQ(run.stats.num_new_maps_after_loss, 1);
+  // Both maps start from two marker locations, directly in the world.
+  EXPECT_EQ(run.stats.num_marker_initializations, 2);
+  std::optional<int> second_init;
+  for (int t = scenario.blackout_end; t < scenario.num_frames && !second_init; ++t) {
+    if (run.reports[t].initialized_map) second_init = t;
+  }
+  ASSERT_TRUE(second_init.has_value());
+  EXPECT_LE(*second_init, scenario.blackout_end + 20);  // 0.5 m of baseline at 0.6 m/s
+  const FrameReport& init = run.reports[*second_init];
+  EXPECT_TRUE(init.world_aligned) << init.message;
+  ASSERT_TRUE(init.cam_from_world.has_value());
+  EXPECT_LT((init.cam_from_world->Inverse().translation -
+             SceneWorldFromCam(*second_init).translation).norm(), 0.015);  // measured 4 mm
+  // Every frame outside the blackout has a world pose (marker poses until the map starts);
+  // absolute error, no alignment (markers alone: about 15 mm).
+  EXPECT_EQ(static_cast<int>(run.trajectory.size()),
+            scenario.num_frames - (scenario.blackout_end - scenario.blackout_begin));
+  EXPECT_LT(SceneAbsoluteRmse(run.trajectory), 0.02);
+  EXPECT_EQ(run.invariants, "");
+}
+
+TEST(SystemRecovery, MapNeverAlignedStaysOutOfTheWorldTrajectory) {
+  Scenario scenario;
+  scenario.markers = true;
+  scenario.markers_until = scenario.blackout_begin;  // no marker after the blackout
+  const ScenarioRun run = RunScenario(scenario);
+  EXPECT_EQ(run.stats.num_new_maps_after_loss, 1);
+  EXPECT_EQ(run.stats.num_initializations, 2);  // the second map is built and tracked ...
+  EXPECT_FALSE(run.reports.back().world_aligned);
+  EXPECT_TRUE(run.reports.back().cam_from_world.has_value());
+  // ... but its poses and keyframes are not in the world frame and are not output.
+  for (const StampedPose& pose : run.trajectory) {
+    EXPECT_LT(SceneFrameOf(pose.timestamp_s), scenario.blackout_begin);
+  }
+  for (const StampedPose& keyframe : run.keyframes) {
+    EXPECT_LT(SceneFrameOf(keyframe.timestamp_s), scenario.blackout_begin);
+  }
+  EXPECT_GE(static_cast<int>(run.trajectory.size()), scenario.blackout_begin);
+  EXPECT_FALSE(run.keyframes.empty());  // the closed aligned map's keyframes are kept
+  EXPECT_LT(SceneAbsoluteRmse(run.trajectory), 0.02);
+}
+
+TEST(SystemRecovery, FarMarkersGiveNoLocation) {
+  Scenario scenario;
+  scenario.num_frames = 30;
+  scenario.blackout_begin = scenario.blackout_end = 0;
+  scenario.markers = true;
+  scenario.marker_size = 0.1;  // 3 m away: 30 sides, beyond max_marker_distance_sides (25)
+  const ScenarioRun far = RunScenario(scenario);
+  EXPECT_EQ(far.stats.num_marker_frames, 0);
+  EXPECT_TRUE(far.trajectory.empty());  // the keypoint map is never put in the world
+  scenario.marker_size = 0.2;  // 15 sides
+  const ScenarioRun near = RunScenario(scenario);
+  EXPECT_GT(near.stats.num_marker_frames, 20);
+}
+
+}  // namespace
+}  // namespace arucoslam
