@@ -261,5 +261,45 @@ TEST(SystemMarkers, MappedMarkersLocateFramesWhereNoKnownMarkerIsSeen) {
   EXPECT_GE(located, 15);
 }
 
+TEST(SystemMarkers, KeypointPoseThatTheMarkersContradictIsRejected) {
+  // Frames 70-79: the markers are detected as a camera 1.5 m to the side would see them (a
+  // keypoint pose in a look-alike place looks like this from the markers' side). The
+  // keypoint pose is then rejected and the frames follow the markers; once the markers agree
+  // again, tracking goes on near the truth.
+  const CameraModel camera = TestCamera();
+  SyntheticFeatureScene scene(camera);
+  SystemOptions options;
+  options.marker_map = WallMarkers();
+  options.keyframes.min_frames_between = 0;
+  System system(camera, options);
+  std::mt19937 rng(7);
+  std::vector<int> truth;
+  const Rigid3 shift(Eigen::Quaterniond::Identity(), Eigen::Vector3d(1.5, 0.0, 0.0));
+  std::vector<FrameReport> reports;
+  for (int t = 0; t < 110; ++t) {
+    const Rigid3 cam_from_world = WorldFromCam(t).Inverse();
+    Frame frame = scene.MakeFrame(FrameId(t), kDt * t, cam_from_world, &truth);
+    const bool spoofed = t >= 70 && t < 80;
+    const Rigid3 seen_from = spoofed ? (shift * WorldFromCam(t)).Inverse() : cam_from_world;
+    reports.push_back(system.ProcessFrame(std::move(frame), Detect(WallMarkers(), camera, seen_from, rng)));
+  }
+  system.Finish();
+  ASSERT_TRUE(system.world_aligned());
+  EXPECT_GE(system.Stats().num_marker_disagreements, 1);
+  for (int t = 70; t < 80; ++t) {
+    if (!reports[t].cam_from_world) continue;
+    const Eigen::Vector3d centre = reports[t].cam_from_world->Inverse().translation;
+    // Never the keypoint pose (at the truth): either no pose or the markers' one.
+    EXPECT_GT((centre - WorldFromCam(t).translation).norm(), 1.0) << t;
+  }
+  int near_truth = 0;
+  for (int t = 100; t < 110; ++t) {
+    if (!reports[t].cam_from_world) continue;
+    const Eigen::Vector3d centre = reports[t].cam_from_world->Inverse().translation;
+    if ((centre - WorldFromCam(t).translation).norm() < 0.05) ++near_truth;
+  }
+  EXPECT_GE(near_truth, 8);
+}
+
 }  // namespace
 }  // namespace arucoslam
