@@ -9,63 +9,21 @@
 
 #include "arucoslam/geometry/umeyama.h"
 #include "arucoslam/pipeline/system.h"
+#include "arucoslam/pipeline/system_test_scene.h"
 #include "arucoslam/slam/synthetic_features.h"
 
 namespace arucoslam {
 namespace {
 
-constexpr double kDt = 0.05;  // 20 Hz
-
-CameraModel TestCamera() {
-  CameraModel camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 500.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
-  return camera;
-}
+using test_scene::kSceneDt;
+using test_scene::SceneCamera;
+using test_scene::SceneDetections;
+using test_scene::SceneMarkers;
 
 // Route position t (any real number): sideways, weaving, slowly turning, metres.
 Rigid3 WorldFromCam(double t) {
   return Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(0.003 * t, Eigen::Vector3d::UnitY())),
                 Eigen::Vector3d(0.03 * t, 0.2 * std::sin(t / 15.0), 0.003 * t));
-}
-
-// 0.4 m markers on a wall 3 m in front of the route.
-MarkerMap WallMarkers() {
-  MarkerMap map;
-  map.dictionary = "DICT_4X4_50";
-  const Eigen::Quaterniond facing(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()));
-  for (int i = 0; i < 11; ++i) {
-    MarkerInfo info;
-    info.id = i;
-    info.size = 0.4;
-    info.world_from_marker = Rigid3(facing, Eigen::Vector3d(-1.0 + 0.5 * i, 0.0, 3.0));
-    map.markers[i] = info;
-  }
-  return map;
-}
-
-// The markers fully in view, corners with 0.3 px Gaussian noise.
-std::vector<MarkerDetection> Detect(const MarkerMap& map, const Rigid3& cam_from_world,
-                                    std::mt19937& rng) {
-  const CameraModel camera = TestCamera();
-  std::normal_distribution<double> noise(0.0, 0.3);
-  std::vector<MarkerDetection> detections;
-  for (const auto& [id, info] : map.markers) {
-    MarkerDetection detection;
-    detection.id = info.id;
-    bool visible = true;
-    const std::array<Eigen::Vector3d, 4> corners = info.CornersInWorld();
-    for (int c = 0; c < 4 && visible; ++c) {
-      const std::optional<Eigen::Vector2d> pixel = camera.Project(cam_from_world * corners[c]);
-      visible = pixel && camera.InImage(*pixel, 5.0);
-      if (visible) detection.corners[c] = *pixel + Eigen::Vector2d(noise(rng), noise(rng));
-    }
-    if (visible) detections.push_back(detection);
-  }
-  return detections;
 }
 
 struct Pass {
@@ -77,18 +35,18 @@ struct Pass {
   bool world_aligned = false;
 };
 
-// Feeds the frames at `route` positions (timestamps kDt apart) to a System, optionally
+// Feeds the frames at `route` positions (timestamps kSceneDt apart) to a System, optionally
 // started from `loaded`. The scene (points and descriptors) is the same for every pass.
 // Frames [blackout_begin, blackout_end) have neither keypoints nor markers.
 Pass RunPass(const std::vector<double>& route, bool markers, bool blocking,
              const MapData* loaded = nullptr, bool loaded_aligned = false,
              bool localize_only = false, std::uint32_t noise_seed = 1,
              std::size_t blackout_begin = 0, std::size_t blackout_end = 0) {
-  SyntheticFeatureScene scene(TestCamera());
+  SyntheticFeatureScene scene(SceneCamera());
   SystemOptions options;
   options.blocking = blocking;
-  if (markers) options.marker_map = WallMarkers();
-  System system(TestCamera(), options);
+  if (markers) options.marker_map = SceneMarkers();
+  System system(SceneCamera(), options);
   if (loaded != nullptr) system.StartFromMap(*loaded, loaded_aligned, localize_only);
   std::mt19937 rng(noise_seed);
   Pass pass;
@@ -96,9 +54,9 @@ Pass RunPass(const std::vector<double>& route, bool markers, bool blocking,
   std::vector<int> truth;
   for (std::size_t i = 0; i < route.size(); ++i) {
     const Rigid3 cam_from_world = WorldFromCam(route[i]).Inverse();
-    Frame frame = scene.MakeFrame(FrameId(i), kDt * i, cam_from_world, &truth);
+    Frame frame = scene.MakeFrame(FrameId(i), kSceneDt * i, cam_from_world, &truth);
     std::vector<MarkerDetection> detections =
-        markers ? Detect(*options.marker_map, cam_from_world, rng) : std::vector<MarkerDetection>{};
+        markers ? SceneDetections(*options.marker_map, SceneCamera(), cam_from_world, rng) : std::vector<MarkerDetection>{};
     if (i >= blackout_begin && i < blackout_end) {
       frame.features = OrbFeatures();
       frame.ResetMatches();
@@ -121,7 +79,7 @@ std::vector<double> Route(double from, double to, double step) {
 }
 
 Eigen::Vector3d TruePosition(const Pass& pass, double timestamp_s) {
-  return WorldFromCam(pass.route[static_cast<std::size_t>(std::lround(timestamp_s / kDt))])
+  return WorldFromCam(pass.route[static_cast<std::size_t>(std::lround(timestamp_s / kSceneDt))])
       .translation;
 }
 
@@ -258,9 +216,9 @@ TEST(SystemMapReuse, LoadedMapIsExtendedWithoutLocaliseOnly) {
 }
 
 TEST(SystemMapReuse, StartFromMapOnlyBeforeTheFirstFrame) {
-  System system(TestCamera());
+  System system(SceneCamera());
   EXPECT_THROW(system.StartFromMap(MapData(), false, true), std::invalid_argument);
-  SyntheticFeatureScene scene(TestCamera());
+  SyntheticFeatureScene scene(SceneCamera());
   std::vector<int> truth;
   system.ProcessFrame(scene.MakeFrame(FrameId(0), 0.0, WorldFromCam(0).Inverse(), &truth));
   const Pass first = RunPass(Route(0, 30, 1), false, true);
