@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cstdio>
+#include <optional>
 
 #include "arucoslam/exe/experiments_report.h"
 #include "arucoslam/exe/marker_only_run.h"
@@ -77,19 +78,26 @@ void AddSlamResults(const SlamRunResult& result, const fs::path& sequence,
                                         LoadWorldSurfaces(world), MapAccuracyOptions{});
 }
 
+// The sequence's markers.json; without one, nullopt and the run's note says so.
+std::optional<MarkerMap> SequenceMarkerMap(const Dataset& dataset, ExperimentRun& run) {
+  const std::optional<fs::path> path = dataset.markers_path();
+  if (!path) {
+    run.note = "the sequence has no markers.json";
+    return std::nullopt;
+  }
+  return ReadMarkerMapJson(*path);
+}
+
 ExperimentRun MarkerOnlyRun(const fs::path& sequence, const fs::path& out_dir, bool progress) {
   ExperimentRun run;
   run.label = "markers only (no SLAM)";
   run.sequence = "with markers";
   const Dataset dataset = Dataset::Open(sequence);
-  const auto markers_path = dataset.markers_path();
-  if (!markers_path) {
-    run.note = "the sequence has no markers.json";
-    return run;
-  }
+  const std::optional<MarkerMap> markers = SequenceMarkerMap(dataset, run);
+  if (!markers) return run;
   MarkerOnlyOptions options;
   options.progress = progress;
-  const MarkerOnlyResult result = RunMarkerOnly(dataset, ReadMarkerMapJson(*markers_path), options);
+  const MarkerOnlyResult result = RunMarkerOnly(dataset, *markers, options);
   run.available = true;
   run.median_frame_ms = result.detection_ms.Summarize().median;
   run.note = fmt::format("{} of {} frames see a known marker; {} ambiguous single-marker views left out",
@@ -105,14 +113,11 @@ ExperimentRun MarkerSlamRun(const fs::path& sequence, const fs::path& out_dir, b
   run.label = "1: ArucoSLAM (markers + keypoints)";
   run.sequence = "with markers";
   const Dataset dataset = Dataset::Open(sequence);
-  const auto markers_path = dataset.markers_path();
-  if (!markers_path) {
-    run.note = "the sequence has no markers.json";
-    return run;
-  }
+  const std::optional<MarkerMap> markers = SequenceMarkerMap(dataset, run);
+  if (!markers) return run;
   SystemOptions options;
   options.blocking = true;
-  options.marker_map = ReadMarkerMapJson(*markers_path);
+  options.marker_map = *markers;
   options.detector.dictionary = options.marker_map->dictionary;
   if (progress) std::fprintf(stderr, "SLAM, %s\n", run.label.c_str());
   const SlamRunResult result =
