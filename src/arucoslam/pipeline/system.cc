@@ -263,9 +263,8 @@ void System::Track(Frame& frame, FrameReport& report) {
     // keep coming and it does not take them back.
     const bool stuck = fix_ && ++lost_with_markers_ >= options_.marker_reset_lost_frames;
     const bool young = static_cast<int>(map_->NumKeyframes()) <= options_.reset_max_keyframes;
-    if (map_loaded_) {
-      // A loaded map is kept: frames relocalise into it.
-    } else if (LostTooLong(frame)) {
+    if (map_loaded_) return;  // a loaded map is kept: frames relocalise into it
+    if (LostTooLong(frame)) {
       ARUCOSLAM_LOG_DEBUG("frame {}: lost for {:.1f} s, starting a new map", report.index,
                           options_.new_map_after_lost_s);
       {
