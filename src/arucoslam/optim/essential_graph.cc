@@ -14,11 +14,22 @@ struct EssentialGraph {
   EssentialGraphResult counts;
 };
 
-void AddEdge(EssentialGraph& graph, KeyframeId from, KeyframeId to, const Sim3& to_from_from) {
+Matrix7d EdgeInformation(const EssentialGraphOptions& options) {
+  Matrix7d information = Matrix7d::Zero();
+  const auto inverse_square = [](double sigma) { return 1.0 / (sigma * sigma); };
+  information.diagonal() << Eigen::Vector3d::Constant(inverse_square(options.edge_translation_sigma)),
+      Eigen::Vector3d::Constant(inverse_square(options.edge_rotation_sigma)),
+      inverse_square(options.edge_scale_sigma);
+  return information;
+}
+
+void AddEdge(EssentialGraph& graph, KeyframeId from, KeyframeId to, const Sim3& to_from_from,
+             const Matrix7d& information) {
   PoseGraphProblem::Edge edge;
   edge.from = graph.index.at(from);
   edge.to = graph.index.at(to);
   edge.to_from_from = to_from_from;
+  edge.information = information;
   graph.problem.edges.push_back(edge);
 }
 
@@ -28,6 +39,7 @@ EssentialGraph Build(const MapData& data, KeyframeId fixed_keyframe,
                      const std::vector<KeyframePosePrior>& priors,
                      const EssentialGraphOptions& options) {
   EssentialGraph graph;
+  const Matrix7d information = EdgeInformation(options);
   for (const auto& [id, keyframe] : data.keyframes()) {
     graph.index[id] = graph.ids.size();
     graph.ids.push_back(id);
@@ -47,20 +59,20 @@ EssentialGraph Build(const MapData& data, KeyframeId fixed_keyframe,
   for (const LoopConstraint& loop : loops) {
     if (graph.index.count(loop.current) == 0 || graph.index.count(loop.candidate) == 0) continue;
     if (!link(loop.current, loop.candidate)) continue;
-    AddEdge(graph, loop.current, loop.candidate, loop.candidate_from_current);
+    AddEdge(graph, loop.current, loop.candidate, loop.candidate_from_current, information);
     ++graph.counts.num_loop_edges;
   }
   const CovisibilityGraph& covisibility = data.covisibility();
   for (const KeyframeId& id : graph.ids) {
     const KeyframeId parent = covisibility.Parent(id);
     if (parent.IsValid() && graph.index.count(parent) != 0 && link(parent, id)) {
-      AddEdge(graph, parent, id, relative(parent, id));
+      AddEdge(graph, parent, id, relative(parent, id), information);
       ++graph.counts.num_tree_edges;
     }
     for (const KeyframeId& other :
          covisibility.CovisibleWithMinWeight(id, options.min_covisibility_weight)) {
       if (other < id && graph.index.count(other) != 0 && link(other, id)) {
-        AddEdge(graph, other, id, relative(other, id));
+        AddEdge(graph, other, id, relative(other, id), information);
         ++graph.counts.num_covisibility_edges;
       }
     }

@@ -29,8 +29,17 @@ struct EssentialGraphOptions {
   // Covisibility edges between keyframes sharing at least this many points (besides the
   // spanning tree and loops).
   int min_covisibility_weight = 100;
+  // Standard deviations of a relative-pose edge's tangent [upsilon; omega; sigma]: metres
+  // (map units), radians, log scale. 1, 1, 1: unit information (weights only matter
+  // relative to the priors' and the loop edges').
+  double edge_translation_sigma = 1.0;
+  double edge_rotation_sigma = 1.0;
+  double edge_scale_sigma = 1.0;
 
-  bool Check() const { return solver.Check() && min_covisibility_weight > 0; }
+  bool Check() const {
+    return solver.Check() && min_covisibility_weight > 0 && edge_translation_sigma > 0.0 &&
+           edge_rotation_sigma > 0.0 && edge_scale_sigma > 0.0;
+  }
 };
 
 struct EssentialGraphResult {

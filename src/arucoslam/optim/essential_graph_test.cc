@@ -168,5 +168,60 @@ TEST(EssentialGraphTest, MarkerPriorsCorrectAMetricMapWithoutALoop) {
   EXPECT_LT(after, before / 5.0);
 }
 
+// Monocular drift between two marker sightings (keyframes 0-3 and 20-23, as a robot passing
+// two docks): a Sim3 graph with the sightings as priors stretches the keyframes between them
+// back (their scale drift included) and moves the points with their keyframes.
+TEST(EssentialGraphTest, MarkerPriorsAtTwoSightingsCorrectTheScaleDriftBetweenThem) {
+  SyntheticLoopOptions options;
+  options.scale_drift = 1.02;
+  options.yaw_drift_rad = 0.004;
+  options.scale_in_loop_edge = false;
+  LoopMap scene;
+  Build(scene, options);
+  std::vector<KeyframePosePrior> priors;
+  for (const int first : {0, 20}) {
+    for (int i = first; i < first + 4; ++i) {
+      priors.push_back({scene.keyframes[i], scene.loop.truth_cam_from_world[i].Inverse(),
+                        1e4 * Matrix6d::Identity()});  // 1 cm, 0.01 rad
+    }
+  }
+  const auto between_rms = [&] {
+    return scene.map.Read([&](const MapData& data) {
+      double sum = 0.0;
+      for (int i = 4; i < 20; ++i) {
+        sum += (data.FindKeyframe(scene.keyframes[i])->CameraCenter() -
+                scene.loop.truth_cam_from_world[i].Inverse().translation)
+                   .squaredNorm();
+      }
+      return std::sqrt(sum / 16.0);
+    });
+  };
+  EssentialGraphOptions graph_options;
+  graph_options.edge_translation_sigma = 0.02;
+  graph_options.edge_rotation_sigma = 0.005;
+  graph_options.edge_scale_sigma = 0.01;
+  const double before = between_rms();
+  const double points_before = PointRms(scene);
+  const EssentialGraphResult result =
+      OptimizeEssentialGraph(scene.map, KeyframeId(), {}, {}, priors, graph_options);
+  ASSERT_TRUE(result.applied) << result.summary.message;
+  EXPECT_EQ(result.num_priors, 8);
+  const double after = between_rms();
+  std::printf("two sightings: keyframe centres between them RMS %.3f -> %.3f m, points %.3f -> "
+              "%.3f m\n", before, after, points_before, PointRms(scene));
+  EXPECT_LT(after, before / 4.0);
+  EXPECT_LT(PointRms(scene), points_before / 2.0);
+}
+
+TEST(EssentialGraphTest, EdgeSigmasMustBePositive) {
+  EssentialGraphOptions options;
+  EXPECT_TRUE(options.Check());
+  options.edge_scale_sigma = 0.0;
+  EXPECT_FALSE(options.Check());
+  options.edge_scale_sigma = 0.01;
+  options.edge_rotation_sigma = -1.0;
+  EXPECT_FALSE(options.Check());
+}
+
 }  // namespace
 }  // namespace arucoslam

@@ -1,6 +1,8 @@
 #include "arucoslam/optim/marker_factors.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <optional>
 #include <utility>
@@ -138,11 +140,25 @@ std::vector<PoseGraphProblem::PosePrior> MarkerPosePriors(const MapData& data,
     }
     if (!best || best->num_marker_inliers < options.min_prior_markers) continue;
     const MarkerPoseOptimizationResult& result = *best;
+    const Eigen::Vector3d centre = result.cam_from_world.Inverse().translation;
+    double nearest_sides = std::numeric_limits<double>::infinity();
+    for (const MarkerPoseObservation& marker : it->second) {
+      nearest_sides = std::min(
+          nearest_sides, (marker.world_from_marker.translation - centre).norm() / marker.size);
+    }
+    if (options.max_prior_distance_sides > 0.0 && nearest_sides > options.max_prior_distance_sides) {
+      continue;
+    }
+    double growth = 1.0;  // variance factor for the distance
+    if (options.prior_reference_distance_sides > 0.0) {
+      const double ratio = nearest_sides / options.prior_reference_distance_sides;
+      growth = std::max(1.0, ratio * ratio * ratio * ratio);
+    }
     const double count = result.num_marker_inliers;
     const double position_information =
-        count / (options.prior_position_sigma_m * options.prior_position_sigma_m);
+        count / (growth * options.prior_position_sigma_m * options.prior_position_sigma_m);
     const double rotation_information =
-        count / (options.prior_rotation_sigma_rad * options.prior_rotation_sigma_rad);
+        count / (growth * options.prior_rotation_sigma_rad * options.prior_rotation_sigma_rad);
     PoseGraphProblem::PosePrior prior;
     prior.node = node;
     prior.world_from_cam = result.cam_from_world.Inverse();

@@ -23,11 +23,17 @@ struct MarkerFactorOptions {
   int min_prior_markers = 1;
   double prior_position_sigma_m = 0.05;
   double prior_rotation_sigma_rad = 0.02;
+  // A marker pose's error grows with the square of its distance: when > 0, both sigmas are
+  // for a camera this many marker sides from its nearest marker and grow as (distance / it)^2
+  // beyond (never shrink below). Priors farther than max_prior_distance_sides (> 0) are left out.
+  double prior_reference_distance_sides = 0.0;
+  double max_prior_distance_sides = 0.0;
 
   bool Check() const {
     return corner_sigma_px > 0.0 && marker_huber_delta > 0.0 &&
            marker_chi_square_threshold > 0.0 && min_prior_markers >= 1 &&
-           prior_position_sigma_m > 0.0 && prior_rotation_sigma_rad > 0.0;
+           prior_position_sigma_m > 0.0 && prior_rotation_sigma_rad > 0.0 &&
+           prior_reference_distance_sides >= 0.0 && max_prior_distance_sides >= 0.0;
   }
 };
 

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <set>
 
 #include "arucoslam/optim/local_bundle_adjustment.h"
@@ -192,6 +194,60 @@ TEST(MarkerFactorsTest, PosePriorsComeFromTheFixedMarkersAlone) {
     EXPECT_LT((prior.world_from_cam.translation - truth.translation).norm(), 0.1) << prior.node;
     EXPECT_LT(prior.world_from_cam.rotation.angularDistance(truth.rotation), 0.02) << prior.node;
     EXPECT_GT(prior.information(0, 0), 0.0);
+  }
+}
+
+// Priors from far markers are weaker (their pose error grows with distance squared) and
+// beyond max_prior_distance_sides there is none.
+TEST(MarkerFactorsTest, PosePriorsWeakenWithDistanceAndStopBeyondTheLimit) {
+  MarkerSceneMap scene;
+  Build(scene, Sim3());
+  // Distance from a prior's camera to the nearest marker its keyframe saw, in marker sides.
+  const auto nearest_sides = [&](const PoseGraphProblem::PosePrior& prior) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const auto& [id, landmark] : scene.landmarks.landmarks()) {
+      if (landmark.observations.count(scene.keyframes[prior.node]) == 0) continue;
+      nearest = std::min(nearest, (landmark.world_from_marker.translation -
+                                   prior.world_from_cam.translation).norm() / landmark.size);
+    }
+    return nearest;
+  };
+  MarkerFactorOptions options;
+  const std::vector<PoseGraphProblem::PosePrior> constant = scene.map.Read([&](const MapData& data) {
+    return MarkerPosePriors(data, scene.keyframes, scene.landmarks, options);
+  });
+  options.prior_reference_distance_sides = 5.0;
+  const std::vector<PoseGraphProblem::PosePrior> all = scene.map.Read([&](const MapData& data) {
+    return MarkerPosePriors(data, scene.keyframes, scene.landmarks, options);
+  });
+  ASSERT_EQ(all.size(), constant.size());
+  ASSERT_GE(all.size(), 4u);
+  // The standard deviations grow as (distance / 5 sides)^2 beyond 5 sides: the information
+  // falls with the fourth power; nearer views keep theirs.
+  double near_sides = std::numeric_limits<double>::infinity(), far_sides = 0.0;
+  int num_far = 0;
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    ASSERT_EQ(all[i].node, constant[i].node);
+    const double sides = nearest_sides(all[i]);
+    near_sides = std::min(near_sides, sides);
+    far_sides = std::max(far_sides, sides);
+    const double expected = sides <= 5.0 ? 1.0 : std::pow(5.0 / sides, 4);
+    num_far += sides > 6.0;
+    EXPECT_NEAR(all[i].information(0, 0) / constant[i].information(0, 0), expected, 0.05 * expected)
+        << "node " << all[i].node << " at " << sides << " sides";
+    EXPECT_NEAR(all[i].information(3, 3) / constant[i].information(3, 3), expected, 0.05 * expected);
+  }
+  ASSERT_GE(num_far, 2);
+
+  const double limit = 0.5 * (near_sides + far_sides);
+  options.max_prior_distance_sides = limit;
+  const std::vector<PoseGraphProblem::PosePrior> near = scene.map.Read([&](const MapData& data) {
+    return MarkerPosePriors(data, scene.keyframes, scene.landmarks, options);
+  });
+  EXPECT_LT(near.size(), all.size());
+  EXPECT_GE(near.size(), 1u);
+  for (const auto& prior : near) {
+    EXPECT_LE(nearest_sides(prior), limit) << prior.node;
   }
 }
 

@@ -74,6 +74,7 @@ void System::MapKeyframe(KeyframeId keyframe) {
   std::unique_lock<std::mutex> edit;  // a loop being closed pauses local mapping
   if (places_) edit = places_->LockMapEdits();
   FeedMarkerMapping(keyframe);
+  CorrectDriftWithMarkers(keyframe);
   const LocalMappingResult r = mapper_->ProcessKeyframe(keyframe);
   const double elapsed = watch.ElapsedMilliseconds();
   if (places_) {
@@ -158,6 +159,7 @@ void System::Initialize(Frame& frame, FrameReport& report) {
     if (enough) {
       init_reference_ = frame;
       init_reference_fix_ = fix_;
+      initialisation_frames_.clear();
     }
     report.message = enough ? "initialisation reference" : "too few features";
     return;
@@ -177,6 +179,9 @@ void System::Initialize(Frame& frame, FrameReport& report) {
     if (result.failure == InitFailure::kTooFewMatches && enough) {
       init_reference_ = frame;
       init_reference_fix_ = fix_;
+      initialisation_frames_.clear();
+    } else if (static_cast<int>(initialisation_frames_.size()) < options_.max_backfill_frames) {
+      initialisation_frames_.push_back(frame);
     }
     return;
   }
@@ -205,6 +210,7 @@ void System::FinishInitialization(Frame& first, Frame& frame, KeyframeId first_i
     }
   }
   RecordPose(frame, second_id);
+  BackfillInitialization(frame, first_id, second_id);
   if (places_) {
     places_->KeyframeMapped(first_id);
     places_->KeyframeMapped(second_id);
@@ -366,8 +372,13 @@ void System::ResetMap() {
   ResetMarkerMapping();
   poses_ = std::move(kept);
   init_reference_.reset();
+  initialisation_frames_.clear();
   init_reference_fix_.reset();
   anchors_.clear();
+  {
+    std::lock_guard lock(keyframe_fixes_mutex_);
+    keyframe_fixes_.clear();
+  }
   next_alignment_anchors_ = 0;
   world_aligned_ = false;
   lost_with_markers_ = 0;

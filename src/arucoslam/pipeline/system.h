@@ -17,6 +17,8 @@
 
 #include "arucoslam/feature/orb_extractor.h"
 #include "arucoslam/map/map.h"
+#include "arucoslam/optim/essential_graph.h"
+#include "arucoslam/optim/marker_factors.h"
 #include "arucoslam/markers/camera_locator.h"
 #include "arucoslam/markers/detector.h"
 #include "arucoslam/markers/marker_map.h"
@@ -102,6 +104,31 @@ struct SystemOptions {
   // (marker poses and relocalisation where the known map has no marker). 0: never.
   int min_locating_marker_keyframes = 3;
   MarkerMapperOptions marker_mapping;
+  // Drift correction (system_drift_correction.cc): a keyframe of the aligned map whose pose
+  // from its known markers lies farther than min_marker_correction_m and than
+  // marker_correction_sigmas of that pose's standard deviation from its keypoint pose
+  // triggers a pose-graph correction of the whole map, with the marker pose of every
+  // keyframe that sees known markers as a prior.
+  bool marker_drift_correction = true;
+  double min_marker_correction_m = 0.05;
+  double marker_correction_sigmas = 3.0;
+  // A keyframe's marker location as a prior: 1 cm and 0.01 rad per marker (divided by
+  // sqrt(markers)) at 10 marker sides and nearer, growing with distance^2 beyond.
+  MarkerFactorOptions marker_priors = [] {
+    MarkerFactorOptions priors;
+    priors.prior_position_sigma_m = 0.01;
+    priors.prior_rotation_sigma_rad = 0.01;
+    priors.prior_reference_distance_sides = 10.0;
+    return priors;
+  }();
+  // Relative poses between keyframes: 2 cm, 0.005 rad and 1% scale per edge.
+  EssentialGraphOptions marker_correction_graph = [] {
+    EssentialGraphOptions graph;
+    graph.edge_translation_sigma = 0.02;
+    graph.edge_rotation_sigma = 0.005;
+    graph.edge_scale_sigma = 0.01;
+    return graph;
+  }();
 
   // Bag-of-words vocabulary. When set, keyframes enter a place database: lost tracking is
   // relocalised from it and, with places.loop_closing, loops are closed. Null: neither.
@@ -116,6 +143,10 @@ struct SystemOptions {
   double min_marker_init_baseline_m = 0.5;
   // ... and at least this median parallax of the triangulated points (degrees).
   double min_marker_init_parallax_deg = 1.0;
+  // Frames between the initialisation reference and the frame that initialised the map
+  // (up to this many, the camera building up parallax) are tracked backwards against the
+  // new map and get poses too. 0: they stay without a keypoint pose.
+  int max_backfill_frames = 150;
 
   bool Check() const;
 };
@@ -160,6 +191,7 @@ struct SystemStats {
   int num_new_maps_after_loss = 0;     // maps started because tracking stayed lost
   int num_marker_initializations = 0;  // maps initialised from two marker locations
   int num_maps_discarded = 0;          // closed maps never aligned (marker map only)
+  int num_marker_corrections = 0;      // pose-graph corrections of drift by markers
 };
 
 struct StampedPose {
@@ -223,6 +255,7 @@ class System {
   struct MarkerFix {  // a usable marker location of the current frame
     Rigid3 world_from_cam;
     std::vector<MarkerPoseObservation> markers;  // its inlier markers, undistorted corners
+    double nearest_marker_sides = 0.0;           // camera to its nearest marker, in sides
   };
 
   void Initialize(Frame& frame, FrameReport& report);
@@ -266,6 +299,12 @@ class System {
   void ResetMarkerMapping();
   void FinishMarkerMapping();
   void PublishLocatingMarkers();  // mapping thread, after a keyframe's markers were added
+  // Mapping thread, after FeedMarkerMapping: the pose-graph correction when the keyframe's
+  // markers contradict its pose (system_drift_correction.cc). True when the map moved.
+  bool CorrectDriftWithMarkers(KeyframeId keyframe);
+  // The pose-graph prior of a keyframe from its marker location (standard deviations from
+  // the marker_priors options).
+  KeyframePosePrior MarkerPrior(KeyframeId keyframe, const MarkerFix& fix) const;
   // The markers to add to a global BA (CollectMarkerFactors / ApplyMarkerFactors) or pose
   // graph (MarkerPosePriors) of the current map; null before world alignment. Use it from
   // the mapping thread or while it is stopped.
@@ -287,6 +326,9 @@ class System {
   bool InitializeFromMarkers(Frame& frame, FrameReport& report);
   void FinishInitialization(Frame& first, Frame& frame, KeyframeId first_id,
                             KeyframeId second_id, int num_points, FrameReport& report);
+  // The frames kept in initialisation_frames_, tracked from `second` back in time with a
+  // tracker of their own: each one tracked gets a pose (system_backfill.cc).
+  void BackfillInitialization(const Frame& second, KeyframeId first_id, KeyframeId second_id);
   // Poses of the current map in its own frame (reference keyframes' final poses).
   std::vector<StampedPose> CurrentMapPoses(bool world_only) const;
   void StartMappingThread();
@@ -301,6 +343,7 @@ class System {
   std::unique_ptr<Tracker> tracker_;
   std::unique_ptr<LocalMapper> mapper_;
   std::optional<Frame> init_reference_;
+  std::vector<Frame> initialisation_frames_;  // after init_reference_, for the backfill
   std::size_t num_frames_ = 0;
   int frames_since_keyframe_ = 0;
   TrackingState last_state_ = TrackingState::kNotInitialized;
@@ -338,6 +381,12 @@ class System {
   std::size_t next_seed_keyframe_ = 0;  // round-robin position of SeedPoseFromKeyframes
   std::unique_ptr<PlaceRecognition> places_;  // with a vocabulary only
   std::uint64_t seen_corrections_ = 0;
+  std::atomic<std::uint64_t> marker_corrections_{0};  // CorrectDriftWithMarkers, any map
+  // The marker location of every keyframe inserted with one (tracking thread writes, the
+  // mapping thread reads for drift correction).
+  mutable std::mutex keyframe_fixes_mutex_;
+  std::map<KeyframeId, MarkerFix> keyframe_fixes_;
+  std::uint64_t seen_marker_corrections_ = 0;
   std::map<KeyframeId, Rigid3> keyframe_poses_;  // as of the previous frame (re-anchoring)
 
   std::unique_ptr<BoundedQueue<KeyframeId>> queue_;

@@ -54,11 +54,14 @@ std::optional<System::MarkerFix> System::LocateWithMarkers(
   const CameraLocation location = LocateCamera(detections, known, camera_, options_.locator);
   report.num_markers = static_cast<int>(location.marker_ids.size());
   std::optional<MarkerFix> fix;
+  const double nearest_sides =
+      location.found ? NearestMarkerInSides(location, known) : std::numeric_limits<double>::infinity();
   if (location.found && !location.quality.ambiguous &&
       location.quality.reprojection_rms_px <= options_.max_marker_rms_px &&
-      NearestMarkerInSides(location, known) <= options_.max_marker_distance_sides) {
+      nearest_sides <= options_.max_marker_distance_sides) {
     fix.emplace();
     fix->world_from_cam = location.world_from_cam;
+    fix->nearest_marker_sides = nearest_sides;
     for (const MarkerDetection& detection : detections) {
       if (!std::binary_search(location.marker_ids.begin(), location.marker_ids.end(),
                               detection.id)) {
@@ -111,6 +114,10 @@ bool System::RelocalizeWithMarkers(Frame& frame, FrameReport& report) {
 
 void System::AddAnchor(KeyframeId keyframe, const std::optional<MarkerFix>& fix) {
   if (!fix || !keyframe.IsValid()) return;
+  {
+    std::lock_guard lock(keyframe_fixes_mutex_);
+    keyframe_fixes_[keyframe] = *fix;
+  }
   if (world_aligned_ && next_alignment_anchors_ > options_.max_realignment_anchors) return;
   anchors_.push_back({keyframe, fix->world_from_cam});
 }

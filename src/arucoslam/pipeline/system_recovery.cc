@@ -98,6 +98,7 @@ bool System::InitializeFromMarkers(Frame& frame, FrameReport& report) {
     if (report.num_features >= options_.initializer.min_matches) {
       init_reference_ = frame;
       init_reference_fix_ = fix_;
+      initialisation_frames_.clear();
       report.message = "initialisation reference (markers)";
       return true;
     }

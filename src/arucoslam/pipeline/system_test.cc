@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -44,10 +45,12 @@ std::shared_ptr<const Vocabulary> ShippedVocabulary() {
 }
 
 RunResult RunSynthetic(bool blocking, int num_frames, bool moving = true,
-                       std::shared_ptr<const Vocabulary> vocabulary = nullptr) {
+                       std::shared_ptr<const Vocabulary> vocabulary = nullptr,
+                       int max_backfill_frames = SystemOptions().max_backfill_frames) {
   SyntheticFeatureScene scene(TestCamera());
   SystemOptions options;
   options.blocking = blocking;
+  options.max_backfill_frames = max_backfill_frames;
   options.vocabulary = std::move(vocabulary);
   System system(TestCamera(), options);
   RunResult run;
@@ -106,6 +109,33 @@ TEST(System, BlockingRunTracksSyntheticSequenceAccurately) {
   EXPECT_EQ(run.invariants, "");
   // The camera travels about 2.4 m; the error bound is 1% of that.
   EXPECT_LT(AlignedRmsError(run.trajectory), 0.024);
+}
+
+TEST(System, FramesBeforeTheInitialisationAreTrackedBackwards) {
+  // The frames between the initialisation reference (frame 0) and the frame that completed
+  // the map get poses in the same map, as accurate as the rest.
+  const int num_frames = 40;
+  const RunResult without = RunSynthetic(true, num_frames, true, nullptr, 0);
+  const RunResult run = RunSynthetic(true, num_frames);
+  ASSERT_GE(run.first_initialised, 3);
+  ASSERT_EQ(without.first_initialised, run.first_initialised);
+  const auto has_pose = [](const RunResult& result, int t) {
+    return std::any_of(result.trajectory.begin(), result.trajectory.end(), [&](const StampedPose& pose) {
+      return std::lround(pose.timestamp_s / 0.05) == t;
+    });
+  };
+  for (int t = 0; t <= run.first_initialised; ++t) {
+    EXPECT_TRUE(has_pose(run, t)) << t;
+    // Without the backfill only the two initial frames have a pose.
+    EXPECT_EQ(has_pose(without, t), t == 0 || t == run.first_initialised) << t;
+  }
+  // Every pose is counted as tracked but the reference frame's (its report had none).
+  EXPECT_EQ(run.stats.num_tracked + 1, static_cast<int>(run.trajectory.size()));
+  for (std::size_t i = 1; i < run.trajectory.size(); ++i) {
+    EXPECT_LT(run.trajectory[i - 1].timestamp_s, run.trajectory[i].timestamp_s);
+  }
+  // The camera travels about 1.2 m; the error bound is 1% of that.
+  EXPECT_LT(AlignedRmsError(run.trajectory), 0.012);
 }
 
 TEST(System, BlockingRunIsDeterministic) {

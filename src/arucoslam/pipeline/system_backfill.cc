@@ -1,0 +1,55 @@
+// System's initialisation backfill: the frames a monocular map needed to build up parallax
+// get poses once the map exists, tracked backwards in time from the frame that initialised it.
+#include <algorithm>
+#include <utility>
+
+#include "arucoslam/pipeline/system.h"
+#include "arucoslam/util/logging.h"
+
+namespace arucoslam {
+
+void System::BackfillInitialization(const Frame& second, KeyframeId first_id,
+                                    KeyframeId second_id) {
+  std::vector<Frame> frames = std::move(initialisation_frames_);
+  initialisation_frames_.clear();
+  if (frames.empty()) return;
+  Tracker backwards(*map_, options_.tracker);
+  backwards.Start(second, second_id);
+  std::vector<TrackedPose> found;
+  for (auto it = frames.rbegin(); it != frames.rend(); ++it) {
+    Frame& frame = *it;
+    frame.ResetMatches();
+    frame.cam_from_world.reset();
+    if (backwards.Track(frame).state != TrackingState::kTracking) break;
+    backwards.SetReferenceKeyframe(first_id);
+    RecordPose(frame, first_id);
+    found.push_back(poses_.back());
+    poses_.pop_back();
+  }
+  ARUCOSLAM_LOG_DEBUG("initialisation backfill: {} of {} earlier frames tracked", found.size(),
+                      frames.size());
+  if (found.empty()) return;
+  // Marker-only poses of the same frames give way to the keypoint ones; time order is kept.
+  std::vector<TrackedPose> merged;
+  merged.reserve(poses_.size() + found.size());
+  int num_replaced = 0;
+  for (TrackedPose& pose : poses_) {
+    const bool replaced = std::any_of(found.begin(), found.end(), [&](const TrackedPose& other) {
+      return other.timestamp_s == pose.timestamp_s;
+    });
+    if (replaced) {
+      ++num_replaced;
+    } else {
+      merged.push_back(std::move(pose));
+    }
+  }
+  merged.insert(merged.end(), found.begin(), found.end());
+  std::stable_sort(merged.begin(), merged.end(), [](const TrackedPose& a, const TrackedPose& b) {
+    return a.timestamp_s < b.timestamp_s;
+  });
+  poses_ = std::move(merged);
+  std::lock_guard lock(stats_mutex_);
+  stats_.num_tracked += static_cast<int>(found.size()) - num_replaced;  // newly with a pose
+}
+
+}  // namespace arucoslam
