@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "arucoslam/markers/candidate_decoder.h"
+#include "arucoslam/markers/threshold_line_fit.h"
 
 namespace arucoslam {
 
@@ -83,6 +84,15 @@ struct DetectorOptions {
   // are decoded as well (small markers that the AprilTag quads miss). Costs about 10% more
   // on the AprilTag photos (bench/marker_bench.cc BM_DetectAprilTagPhoto).
   bool rescue_contour_candidates = true;
+  // Every detection's corners refitted on the input image to the crossings of a local
+  // threshold (threshold_line_fit.h), whatever found them; kept as found where the fit
+  // fails. On the apriltag_detect_unit photos (AprilTag options above) the mean corner
+  // distance to the apriltag library's corners drops from 0.38 to 0.28 px; on rendered
+  // small tilted markers the mean error to the truth from 0.19 to 0.12 px (AprilTag options)
+  // and from 0.41 to 0.12 px (the defaults) (threshold_line_fit_test.cc). Costs about
+  // 0.1 ms per marker.
+  bool threshold_line_fit = false;
+  ThresholdLineFitOptions threshold_fit;
 
   bool Check() const;
   cv::Ptr<cv::aruco::DetectorParameters> ToOpenCv() const;
