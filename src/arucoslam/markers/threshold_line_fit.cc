@@ -59,8 +59,18 @@ class TileThreshold {
     }
   }
 
-  // The pixel's threshold, -1 where the contrast is too low.
-  int At(int x, int y) const { return threshold_[(TileY(y) - ty0_) * width_ + TileX(x) - tx0_]; }
+  // The threshold of each pixel of the window, -1 where the contrast is too low.
+  cv::Mat1s PerPixel(cv::Rect window) const {
+    std::vector<int> column_tile(window.width);
+    for (int x = 0; x < window.width; ++x) column_tile[x] = TileX(window.x + x) - tx0_;
+    cv::Mat1s map(window.size());
+    for (int y = 0; y < window.height; ++y) {
+      const int* tiles = &threshold_[(TileY(window.y + y) - ty0_) * width_];
+      short* row = map[y];
+      for (int x = 0; x < window.width; ++x) row[x] = static_cast<short>(tiles[column_tile[x]]);
+    }
+    return map;
+  }
 
  private:
   int TileX(int x) const { return std::min(x / tile_, tiles_x_ - 1); }
@@ -86,41 +96,105 @@ double GradientMagnitude(const cv::Mat& gray, cv::Point2d p) {
   return std::sqrt(gx * gx + gy * gy);
 }
 
+// The quad's sides as lines, each with the band of crossings it takes.
+struct Sides {
+  std::array<cv::Point2d, 4> start, along, outward;
+  std::array<double, 4> length, band;
+
+  // Whether `point` lies within `distance` of one of the sides' lines.
+  bool Near(cv::Point2d point, double distance) const {
+    for (int k = 0; k < 4; ++k) {
+      if (std::abs((point - start[k]).dot(outward[k])) <= distance) return true;
+    }
+    return false;
+  }
+
+  // The side that takes a crossing at `point` stepping up towards `direction`: within its
+  // band (+ slack px) of it, between its ends (+- slack px), dark inside; the nearest of
+  // those. -1 when none.
+  int Take(cv::Point2d point, cv::Point2d direction, double slack) const {
+    int best = -1;
+    double best_distance = 0.0;
+    for (int k = 0; k < 4; ++k) {
+      if (direction.dot(outward[k]) < 0.0) continue;  // bright inside
+      const cv::Point2d offset = point - start[k];
+      const double distance = std::abs(offset.dot(outward[k]));
+      const double s = offset.dot(along[k]);
+      if (distance > band[k] + slack || s < -slack || s > length[k] + slack) continue;
+      if (best < 0 || distance < best_distance) {
+        best = k;
+        best_distance = distance;
+      }
+    }
+    return best;
+  }
+};
+
+// nullopt for a degenerate quad. `outward_sign`: +1 when the corners run clockwise on screen.
+std::optional<Sides> MakeSides(const std::array<cv::Point2d, 4>& corners, double outward_sign,
+                               int cells, const ThresholdLineFitOptions& options) {
+  Sides sides;
+  for (int k = 0; k < 4; ++k) {
+    sides.start[k] = corners[k];
+    const cv::Point2d side = corners[(k + 1) % 4] - corners[k];
+    sides.length[k] = cv::norm(side);
+    if (sides.length[k] < 1e-6) return std::nullopt;
+    sides.along[k] = side * (1.0 / sides.length[k]);
+    sides.outward[k] = outward_sign * cv::Point2d(sides.along[k].y, -sides.along[k].x);
+  }
+  for (int k = 0; k < 4; ++k) {
+    // The marker's width at this side: how far inside the opposite side lies.
+    const int opposite = (k + 2) % 4;
+    const double width = -0.5 * ((corners[opposite] - corners[k]).dot(sides.outward[k]) +
+                                 (corners[(opposite + 1) % 4] - corners[k]).dot(sides.outward[k]));
+    sides.band[k] =
+        std::clamp(options.band_cells * width / cells, options.min_band_px, options.max_band_px);
+  }
+  return sides;
+}
+
+// The crossings in `window` that `sides` takes with `slack`.
 std::vector<Crossing> FindCrossings(const cv::Mat& gray, cv::Rect window,
-                                    const ThresholdLineFitOptions& options) {
-  const TileThreshold threshold(gray, window, options.tile_px, options.min_contrast);
+                                    const ThresholdLineFitOptions& options, const Sides& sides,
+                                    double slack) {
+  const cv::Mat1s threshold =
+      TileThreshold(gray, window, options.tile_px, options.min_contrast).PerPixel(window);
+  // 0: dark, 1: bright, 2: neither.
+  cv::Mat1b level(window.size());
+  for (int y = 0; y < window.height; ++y) {
+    const uchar* grey = gray.ptr<uchar>(window.y + y) + window.x;
+    for (int x = 0; x < window.width; ++x) {
+      const int t = threshold(y, x);
+      level(y, x) = t < 0 ? 2 : grey[x] > t ? 1 : 0;
+    }
+  }
   // Each pixel with its right, lower and two lower diagonal neighbours.
   const cv::Point steps[] = {{1, 0}, {0, 1}, {1, 1}, {-1, 1}};
   std::vector<Crossing> crossings;
-  for (int y = window.y; y < window.y + window.height; ++y) {
-    for (int x = window.x; x < window.x + window.width; ++x) {
-      const int t0 = threshold.At(x, y);
-      if (t0 < 0) continue;
-      const int v0 = gray.at<uchar>(y, x);
+  // Pixels further than this from every side's line give no crossing that a side takes.
+  const double reach = *std::max_element(sides.band.begin(), sides.band.end()) + slack + 1.5;
+  for (int y = 0; y < window.height; ++y) {
+    for (int x = 0; x < window.width; ++x) {
+      const int level0 = level(y, x);
+      if (level0 == 2 || !sides.Near(cv::Point2d(window.x + x, window.y + y), reach)) continue;
       for (const cv::Point& step : steps) {
         const int x1 = x + step.x, y1 = y + step.y;
-        if (x1 < window.x || x1 >= window.x + window.width || y1 >= window.y + window.height) {
-          continue;
-        }
-        const int t1 = threshold.At(x1, y1);
-        if (t1 < 0) continue;
-        const int v1 = gray.at<uchar>(y1, x1);
-        const bool bright0 = v0 > t0, bright1 = v1 > t1;
-        if (bright0 == bright1) continue;
+        if (x1 < 0 || x1 >= window.width || y1 >= window.height) continue;
+        const int level1 = level(y1, x1);
+        if (level1 == 2 || level1 == level0) continue;
         // From the dark pixel to the bright one.
-        cv::Point2d dark(x, y), bright(x1, y1);
-        int v_dark = v0, v_bright = v1;
-        if (bright0) {
-          std::swap(dark, bright);
-          std::swap(v_dark, v_bright);
-        }
+        cv::Point dark(x, y), bright(x1, y1);
+        if (level0 == 1) std::swap(dark, bright);
+        const int v_dark = gray.at<uchar>(window.y + dark.y, window.x + dark.x);
+        const int v_bright = gray.at<uchar>(window.y + bright.y, window.x + bright.x);
         // The crossing of the (mean) threshold, interpolated linearly between the pixels.
-        double f = 0.5;
-        if (v_bright != v_dark) {
-          f = std::clamp((0.5 * (t0 + t1) + 0.5 - v_dark) / (v_bright - v_dark), 0.0, 1.0);
-        }
-        const cv::Point2d point = dark + f * (bright - dark);
-        const cv::Point2d direction = (bright - dark) * (1.0 / cv::norm(bright - dark));
+        const double t = 0.5 * (threshold(dark) + threshold(bright)) + 0.5;
+        const double f =
+            v_bright != v_dark ? std::clamp((t - v_dark) / (v_bright - v_dark), 0.0, 1.0) : 0.5;
+        const cv::Point2d origin(window.x, window.y);
+        const cv::Point2d point = origin + cv::Point2d(dark) + f * cv::Point2d(bright - dark);
+        const cv::Point2d direction = cv::Point2d(bright - dark) * (1.0 / cv::norm(bright - dark));
+        if (sides.Take(point, direction, slack) < 0) continue;
         crossings.push_back({point, direction, GradientMagnitude(gray, point) + 1.0});
       }
     }
@@ -132,7 +206,8 @@ std::vector<Crossing> FindCrossings(const cv::Mat& gray, cv::Rect window,
 
 bool ThresholdLineFitOptions::Check() const {
   return tile_px >= 2 && min_contrast >= 0.0 && band_cells > 0.0 && min_band_px >= 0.0 &&
-         iterations >= 1 && min_points_per_side >= 2 && max_shift_cells > 0.0;
+         max_band_px >= min_band_px && iterations >= 1 && min_points_per_side >= 2 &&
+         max_shift_cells > 0.0;
 }
 
 bool FitQuadToThreshold(const cv::Mat& gray, int cells, const ThresholdLineFitOptions& options,
@@ -152,53 +227,27 @@ bool FitQuadToThreshold(const cv::Mat& gray, int cells, const ThresholdLineFitOp
   for (int k = 0; k < 4; ++k) area += current[k].cross(current[(k + 1) % 4]);
   const double outward_sign = area > 0 ? 1.0 : -1.0;
 
-  // Crossings over the quad's bounding box with room for the bands and corner moves.
-  cv::Rect2d box = cv::boundingRect(std::vector<cv::Point2f>(corners.begin(), corners.end()));
-  const double margin = std::max(options.min_band_px, options.band_cells * cell) +
-                        options.max_shift_cells * cell + 2.0;
+  // The crossings near the sides, with some slack for the sides' moves.
+  const std::optional<Sides> initial = MakeSides(current, outward_sign, cells, options);
+  if (!initial) return false;
+  const double slack = 1.5;  // px
+  const double margin = *std::max_element(initial->band.begin(), initial->band.end()) + slack + 1.0;
+  const cv::Rect2d box = cv::boundingRect(std::vector<cv::Point2f>(corners.begin(), corners.end()));
   const cv::Rect window = cv::Rect(static_cast<int>(std::floor(box.x - margin)),
                                    static_cast<int>(std::floor(box.y - margin)),
                                    static_cast<int>(std::ceil(box.width + 2 * margin)) + 1,
                                    static_cast<int>(std::ceil(box.height + 2 * margin)) + 1) &
                           cv::Rect(0, 0, gray.cols, gray.rows);
   if (window.width < 2 || window.height < 2) return false;
-  const std::vector<Crossing> crossings = FindCrossings(gray, window, options);
+  const std::vector<Crossing> crossings = FindCrossings(gray, window, options, *initial, slack);
 
   for (int iteration = 0; iteration < options.iterations; ++iteration) {
-    std::array<cv::Point2d, 4> start, along, outward;
-    std::array<double, 4> length, band;
-    for (int k = 0; k < 4; ++k) {
-      start[k] = current[k];
-      const cv::Point2d side = current[(k + 1) % 4] - current[k];
-      length[k] = cv::norm(side);
-      if (length[k] < 1e-6) return false;
-      along[k] = side * (1.0 / length[k]);
-      outward[k] = outward_sign * cv::Point2d(along[k].y, -along[k].x);
-    }
-    for (int k = 0; k < 4; ++k) {
-      // The marker's width at this side: how far inside the opposite side lies.
-      const int opposite = (k + 2) % 4;
-      const double width = -0.5 * ((current[opposite] - start[k]).dot(outward[k]) +
-                                   (current[(opposite + 1) % 4] - start[k]).dot(outward[k]));
-      band[k] = std::max(options.min_band_px, options.band_cells * width / cells);
-    }
+    const std::optional<Sides> sides = MakeSides(current, outward_sign, cells, options);
+    if (!sides) return false;
     std::array<std::vector<WeightedPoint>, 4> assigned;
     for (const Crossing& crossing : crossings) {
-      int best = -1;
-      double best_distance = 0.0;
-      for (int k = 0; k < 4; ++k) {
-        const cv::Point2d offset = crossing.point - start[k];
-        const double distance = std::abs(offset.dot(outward[k]));
-        const double t = offset.dot(along[k]) / length[k];
-        if (distance > band[k] || t < 0.0 || t > 1.0) continue;
-        // Dark inside, bright outside: the crossing must not step up inwards.
-        if (crossing.direction.dot(outward[k]) < 0.0) continue;  // not dark inside
-        if (best < 0 || distance < best_distance) {
-          best = k;
-          best_distance = distance;
-        }
-      }
-      if (best >= 0) assigned[best].push_back({crossing.point, crossing.weight});
+      const int k = sides->Take(crossing.point, crossing.direction, 0.0);
+      if (k >= 0) assigned[k].push_back({crossing.point, crossing.weight});
     }
     std::array<FittedLine, 4> lines;
     for (int k = 0; k < 4; ++k) {

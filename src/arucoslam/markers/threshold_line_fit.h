@@ -17,9 +17,10 @@ struct ThresholdLineFitOptions {
   int tile_px = 4;
   double min_contrast = 5.0;
   // A crossing belongs to a side within band_cells of a cell across the marker (the
-  // marker's width at that side / cells) of its line, at least min_band_px.
+  // marker's width at that side / cells) of its line, clamped to [min_band_px, max_band_px].
   double band_cells = 0.6;
   double min_band_px = 0.75;
+  double max_band_px = 3.0;
   int iterations = 3;  // crossings are re-assigned to the refitted lines
   int min_points_per_side = 3;
   double max_shift_cells = 0.75;  // a corner moving further fails the fit
