@@ -349,7 +349,7 @@ void System::ResetMap() {
     for (TrackedPose pose : poses_) {
       if (!pose.in_world) continue;
       if (const Keyframe* reference = data.FindKeyframe(pose.reference)) {
-        pose.cam_from_world = pose.cam_from_reference * reference->cam_from_world;
+        pose.cam_from_world = PoseFromReference(pose, reference->cam_from_world);
       }
       pose.reference = KeyframeId();
       kept.push_back(pose);
