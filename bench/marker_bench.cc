@@ -57,6 +57,22 @@ void BM_Detect(benchmark::State& state) {
 }
 BENCHMARK(BM_Detect)->Args({640, 480})->Args({1280, 720})->Unit(benchmark::kMillisecond);
 
+// The default options at 640x480 with the threshold line fit of the corners (1) or without.
+void BM_DetectThresholdLineFit(benchmark::State& state) {
+  const cv::Mat image = RenderSyntheticView(Camera(640, 480), Markers(), {});
+  DetectorOptions options;
+  options.threshold_line_fit = state.range(0) != 0;
+  const MarkerDetector detector(options);
+  size_t found = 0;
+  for (auto _ : state) {
+    const std::vector<MarkerDetection> detections = detector.Detect(image);
+    found = detections.size();
+    benchmark::DoNotOptimize(detections.data());
+  }
+  state.counters["markers"] = static_cast<double>(found);
+}
+BENCHMARK(BM_DetectThresholdLineFit)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
 // The small-marker options of DetectorOptions at 640x480: upsample factor x 10 (10: none)
 // and the second decoding of rejected candidates (0 or 1).
 void BM_DetectSmallMarkerOptions(benchmark::State& state) {
@@ -81,7 +97,8 @@ BENCHMARK(BM_DetectSmallMarkerOptions)
     ->Unit(benchmark::kMillisecond);
 
 // The real-photo options of the apriltag_detect_unit test (799x533 photo, tag36h11, AprilTag
-// quads at 2x with the rescue decoder, with and without its contour candidates: 1 or 0).
+// quads at 2x with the rescue decoder): with and without its contour candidates (first
+// argument 1 or 0) and the threshold line fit of the corners (second argument 1 or 0).
 void BM_DetectAprilTagPhoto(benchmark::State& state) {
   const std::string path = std::string(ARUCOSLAM_TEST_DATA_DIR) +
                            "/apriltag_detect_unit/34085369442_304b6bafd9_c.jpg";
@@ -98,6 +115,7 @@ void BM_DetectAprilTagPhoto(benchmark::State& state) {
   options.upsample = 2.0;
   options.rescue_rejected = true;
   options.rescue_contour_candidates = state.range(0) != 0;
+  options.threshold_line_fit = state.range(1) != 0;
   const MarkerDetector detector(options);
   size_t found = 0;
   for (auto _ : state) {
@@ -107,7 +125,11 @@ void BM_DetectAprilTagPhoto(benchmark::State& state) {
   }
   state.counters["markers"] = static_cast<double>(found);
 }
-BENCHMARK(BM_DetectAprilTagPhoto)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DetectAprilTagPhoto)
+    ->Args({0, 0})
+    ->Args({1, 0})
+    ->Args({1, 1})
+    ->Unit(benchmark::kMillisecond);
 
 void BM_PreprocessClahe(benchmark::State& state) {
   const CameraModel camera = Camera(640, 480);

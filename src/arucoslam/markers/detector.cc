@@ -35,7 +35,8 @@ bool DetectorOptions::Check() const {
          error_correction_rate >= 0.0 && error_correction_rate <= 1.0 &&
          dedup_distance_rate >= 0.0 && marker_border_bits >= 1 &&
          (april_tag_quad_decimate == 0.0 || april_tag_quad_decimate >= 1.0) &&
-         april_tag_quad_sigma >= 0.0 && upsample >= 1.0 && upsample <= 8.0 && rescue.Check();
+         april_tag_quad_sigma >= 0.0 && upsample >= 1.0 && upsample <= 8.0 && rescue.Check() &&
+         threshold_fit.Check();
 }
 
 cv::Ptr<cv::aruco::DetectorParameters> DetectorOptions::ToOpenCv() const {
@@ -192,6 +193,18 @@ std::vector<MarkerDetection> MarkerDetector::Detect(const cv::Mat& image) const 
                                contour_rejected);
       rescue_candidates(contour_corners);
       rescue_candidates(contour_rejected);
+    }
+  }
+  if (options_.threshold_line_fit) {
+    const int cells = dictionary_->markerSize + 2 * options_.marker_border_bits;
+    for (MarkerDetection& detection : detections) {
+      std::array<cv::Point2f, 4> corners;
+      for (int k = 0; k < 4; ++k) {
+        corners[k] = cv::Point2f(static_cast<float>(detection.corners[k].x()),
+                                 static_cast<float>(detection.corners[k].y()));
+      }
+      if (!FitQuadToThreshold(gray, cells, options_.threshold_fit, corners)) continue;
+      for (int k = 0; k < 4; ++k) detection.corners[k] = {corners[k].x, corners[k].y};
     }
   }
   return RemoveDuplicateDetections(std::move(detections), options_.dedup_distance_rate);

@@ -5,6 +5,8 @@
 #include <optional>
 #include <vector>
 
+#include "arucoslam/markers/line_fit.h"
+
 namespace arucoslam {
 namespace {
 
@@ -19,19 +21,13 @@ double GreyAt(const cv::Mat& gray, double x, double y) {
          ay * ((1 - ax) * row1[x0] + ax * row1[x0 + 1]);
 }
 
-// A line n.p = c with unit normal n.
-struct Line {
-  cv::Point2d normal;
-  double offset;
-};
-
 // Fits the edge along side a->b whose outward normal is `outward`: at points spread along
 // the side, the grey profile across it is read and the dark-to-bright step located as the
 // centroid of the outward derivative around its strongest (positive) peak. nullopt with
 // too few edge points.
-std::optional<Line> FitSide(const cv::Mat& gray, cv::Point2d a, cv::Point2d b,
-                            cv::Point2d outward, double search_px, double min_fraction,
-                            double min_step) {
+std::optional<FittedLine> FitSide(const cv::Mat& gray, cv::Point2d a, cv::Point2d b,
+                                  cv::Point2d outward, double search_px, double min_fraction,
+                                  double min_step) {
   const double length = cv::norm(b - a);
   const int samples = std::clamp(static_cast<int>(length / 1.5), 4, 24);
   const double step = 0.25;  // px along the normal
@@ -78,31 +74,9 @@ std::optional<Line> FitSide(const cv::Mat& gray, cv::Point2d a, cv::Point2d b,
   if (points.size() < std::max<size_t>(3, static_cast<size_t>(min_fraction * samples))) {
     return std::nullopt;
   }
-  // Weighted total least squares.
-  double w_sum = 0.0;
-  cv::Point2d mean(0, 0);
-  for (size_t i = 0; i < points.size(); ++i) {
-    w_sum += weights[i];
-    mean += weights[i] * points[i];
-  }
-  mean *= 1.0 / w_sum;
-  double sxx = 0.0, sxy = 0.0, syy = 0.0;
-  for (size_t i = 0; i < points.size(); ++i) {
-    const cv::Point2d d = points[i] - mean;
-    sxx += weights[i] * d.x * d.x;
-    sxy += weights[i] * d.x * d.y;
-    syy += weights[i] * d.y * d.y;
-  }
-  const double angle = 0.5 * std::atan2(2.0 * sxy, sxx - syy);  // direction of the line
-  const cv::Point2d normal(-std::sin(angle), std::cos(angle));
-  return Line{normal, normal.dot(mean)};
-}
-
-std::optional<cv::Point2d> Intersect(const Line& l1, const Line& l2) {
-  const double det = l1.normal.x * l2.normal.y - l1.normal.y * l2.normal.x;
-  if (std::abs(det) < 1e-6) return std::nullopt;
-  return cv::Point2d((l1.offset * l2.normal.y - l2.offset * l1.normal.y) / det,
-                     (l1.normal.x * l2.offset - l2.normal.x * l1.offset) / det);
+  std::vector<WeightedPoint> weighted(points.size());
+  for (size_t i = 0; i < points.size(); ++i) weighted[i] = {points[i], weights[i]};
+  return FitWeightedLine(weighted);
 }
 
 }  // namespace
@@ -116,19 +90,20 @@ bool RefineQuadEdges(const cv::Mat& gray, int cells, const EdgeRefineOptions& op
   std::array<cv::Point2d, 4> current;
   for (int k = 0; k < 4; ++k) current[k] = corners[k];
   for (int iteration = 0; iteration < options.iterations; ++iteration) {
-    std::array<Line, 4> lines;
+    std::array<FittedLine, 4> lines;
     for (int k = 0; k < 4; ++k) {
       const cv::Point2d a = current[k], b = current[(k + 1) % 4];
       const cv::Point2d along = (b - a) * (1.0 / std::max(1e-9, cv::norm(b - a)));
       // Clockwise on screen with y down: the outside is on the left of a->b.
       const cv::Point2d outward(along.y, -along.x);
-      const std::optional<Line> line = FitSide(gray, a, b, outward, options.search_cells * cell,
-                                               options.min_edge_fraction, options.min_step);
+      const std::optional<FittedLine> line =
+          FitSide(gray, a, b, outward, options.search_cells * cell, options.min_edge_fraction,
+                  options.min_step);
       if (!line) return false;
       lines[k] = *line;
     }
     for (int k = 0; k < 4; ++k) {
-      const std::optional<cv::Point2d> corner = Intersect(lines[(k + 3) % 4], lines[k]);
+      const std::optional<cv::Point2d> corner = IntersectLines(lines[(k + 3) % 4], lines[k]);
       if (!corner) return false;
       current[k] = *corner;
     }

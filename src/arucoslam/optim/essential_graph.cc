@@ -105,10 +105,11 @@ Rigid3 ToRigid(const Sim3& cam_from_world) {
   return Rigid3(cam_from_world.rotation, cam_from_world.translation / cam_from_world.scale);
 }
 
-int Apply(MapData& data, const EssentialGraph& graph) {
+int Apply(MapData& data, const EssentialGraph& graph, std::map<KeyframeId, double>* scales) {
   std::map<KeyframeId, Sim3> corrections;
   for (const auto& [id, keyframe] : data.keyframes()) {
     corrections[id] = WorldCorrection(data, graph, id);
+    (*scales)[id] = corrections[id].scale;
   }
   for (const auto& [id, correction] : corrections) {
     const Keyframe* keyframe = data.FindKeyframe(id);
@@ -167,7 +168,8 @@ EssentialGraphResult OptimizeEssentialGraph(Map& map, KeyframeId fixed_keyframe,
   EssentialGraphResult result = graph.counts;
   result.summary = SolvePoseGraph(options.solver, &graph.problem);
   if (!result.summary.success) return result;
-  result.num_corrected_points = map.Write([&](MapData& data) { return Apply(data, graph); });
+  result.num_corrected_points =
+      map.Write([&](MapData& data) { return Apply(data, graph, &result.scale_changes); });
   result.applied = true;
   return result;
 }

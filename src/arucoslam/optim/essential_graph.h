@@ -50,6 +50,9 @@ struct EssentialGraphResult {
   int num_loop_edges = 0;
   int num_priors = 0;
   int num_corrected_points = 0;
+  // Per keyframe: scale of its world correction (new map units per old unit around it); a
+  // pose kept relative to the keyframe has its offset multiplied by it.
+  std::map<KeyframeId, double> scale_changes;
   PoseGraphSummary summary;
 };
 

@@ -81,6 +81,20 @@ void PlaceRecognition::KeyframeMapped(KeyframeId keyframe) {
 
 void PlaceRecognition::MapMovedExternally() { ++epoch_; }
 
+double PlaceRecognition::KeyframeScale(KeyframeId keyframe) const {
+  std::lock_guard lock(scale_mutex_);
+  const auto it = keyframe_scales_.find(keyframe);
+  return it != keyframe_scales_.end() ? it->second : 1.0;
+}
+
+void PlaceRecognition::RecordScaleChanges(const std::map<KeyframeId, double>& changes) {
+  std::lock_guard lock(scale_mutex_);
+  for (const auto& [id, scale] : changes) {
+    const auto [it, added] = keyframe_scales_.emplace(id, scale);
+    if (!added) it->second *= scale;
+  }
+}
+
 void PlaceRecognition::SetMetricMap(bool metric) { closer_.SetMetricMap(metric); }
 
 void PlaceRecognition::IndexExistingKeyframes() {
@@ -139,6 +153,7 @@ void PlaceRecognition::DetectAndClose(KeyframeId keyframe) {
       std::unique_lock edit = LockMapEdits();  // local mapping waits meanwhile
       result = closer_.CloseLoop(keyframe, candidate);
       if (result.closed) {
+        RecordScaleChanges(result.essential_graph.scale_changes);
         ++epoch_;  // a global BA solving the old map must not overwrite the correction
         ++corrections_;
       }

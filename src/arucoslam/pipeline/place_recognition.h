@@ -5,6 +5,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -90,11 +91,16 @@ class PlaceRecognition {
   // Incremented by each closed loop and applied global BA: the tracking thread re-anchors
   // its last pose to its reference keyframe when this changes.
   std::uint64_t corrections() const { return corrections_; }
+  // Product of the scale changes that closed loops applied around `keyframe` (1 when none;
+  // kept for culled keyframes). A pose held relative to the keyframe since this was `then`
+  // has its offset multiplied by KeyframeScale / then.
+  double KeyframeScale(KeyframeId keyframe) const;
   // Waits for queued keyframes and a running global BA; idempotent.
   void Finish();
 
  private:
   void AddToDatabase(KeyframeId keyframe);
+  void RecordScaleChanges(const std::map<KeyframeId, double>& changes);
   void DetectAndClose(KeyframeId keyframe);
   void RequestGlobalBundleAdjustment();
   void RunGlobalBundleAdjustmentOnce();
@@ -117,6 +123,8 @@ class PlaceRecognition {
   std::mutex edit_mutex_;
   std::uint64_t epoch_ = 0;  // under edit_mutex_: bumped by every change a global BA cannot merge
   std::atomic<std::uint64_t> corrections_{0};
+  mutable std::mutex scale_mutex_;
+  std::map<KeyframeId, double> keyframe_scales_;  // see KeyframeScale
 
   std::unique_ptr<BoundedQueue<KeyframeId>> queue_;
   std::thread loop_thread_;

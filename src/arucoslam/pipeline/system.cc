@@ -340,6 +340,7 @@ void System::RecordPose(const Frame& frame, KeyframeId reference) {
     return keyframe ? std::optional<Rigid3>(keyframe->cam_from_world) : std::nullopt;
   });
   if (!reference_pose) pose.reference = KeyframeId();
+  pose.reference_scale = ReferenceScale(pose.reference);
   pose.cam_from_reference =
       reference_pose ? pose.cam_from_world * reference_pose->Inverse() : pose.cam_from_world;
   poses_.push_back(pose);
@@ -354,7 +355,7 @@ void System::ResetMap() {
     for (TrackedPose pose : poses_) {
       if (!pose.in_world) continue;
       if (const Keyframe* reference = data.FindKeyframe(pose.reference)) {
-        pose.cam_from_world = pose.cam_from_reference * reference->cam_from_world;
+        pose.cam_from_world = PoseFromReference(pose, reference->cam_from_world);
       }
       pose.reference = KeyframeId();
       kept.push_back(pose);
@@ -403,7 +404,7 @@ std::vector<StampedPose> System::CurrentMapPoses(bool world_only) const {
       if (world_only && !pose.in_world) continue;
       const Keyframe* reference = data.FindKeyframe(pose.reference);
       const Rigid3 cam_from_world =
-          reference ? pose.cam_from_reference * reference->cam_from_world : pose.cam_from_world;
+          reference ? PoseFromReference(pose, reference->cam_from_world) : pose.cam_from_world;
       trajectory.push_back({pose.timestamp_s, cam_from_world.Inverse()});
     }
     return 0;

@@ -245,6 +245,7 @@ class System {
     double timestamp_s = 0.0;
     KeyframeId reference;
     Rigid3 cam_from_reference;
+    double reference_scale = 1.0;  // the reference's KeyframeScale when recorded (loops)
     Rigid3 cam_from_world;
     bool in_world = false;  // expressed in the marker world (kept across map resets)
   };
@@ -285,6 +286,10 @@ class System {
   // keyframe into the corrected map. Also re-anchors poses whose reference keyframe was
   // culled to the keyframe nearest in time, so that later corrections move them too.
   void FollowMapCorrections();
+  // A tracked pose from its reference keyframe's pose; the offset follows the scale changes
+  // that loop corrections applied around the reference since the pose was recorded.
+  Rigid3 PoseFromReference(const TrackedPose& pose, const Rigid3& reference_cam_from_world) const;
+  double ReferenceScale(KeyframeId reference) const;
   void ReanchorOrphanPoses();
   // The map was moved as a whole (world alignment): the cached keyframe poses that
   // ReanchorOrphanPoses compares against are re-read.

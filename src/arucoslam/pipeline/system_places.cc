@@ -64,8 +64,9 @@ void System::ReanchorOrphanPoses() {
     }
     const KeyframeId anchor = nearest->second;
     if (now.count(anchor) == 0) continue;
-    pose.cam_from_world = pose.cam_from_reference * last->second;
+    pose.cam_from_world = PoseFromReference(pose, last->second);
     pose.reference = anchor;
+    pose.reference_scale = ReferenceScale(anchor);
     pose.cam_from_reference = pose.cam_from_world * now.at(anchor).Inverse();
   }
   keyframe_poses_ = std::move(now);
@@ -96,9 +97,24 @@ void System::FollowMapCorrections() {
     return keyframe ? std::optional<Rigid3>(keyframe->cam_from_world) : std::nullopt;
   });
   if (!reference) return;
-  // world_now_from_world_then, rigid: the camera keeps its pose relative to its reference.
-  const Rigid3 cam_from_world_now = last.cam_from_reference * *reference;
-  tracker_->ApplySimilarity(Sim3(cam_from_world_now.Inverse() * last.cam_from_world));
+  // world_now_from_world_then: the camera keeps its pose relative to its reference, its
+  // surroundings (and so its velocity) scaled as the reference's.
+  const Rigid3 cam_from_world_now = PoseFromReference(last, *reference);
+  const double scale = ReferenceScale(last.reference) / last.reference_scale;
+  tracker_->ApplySimilarity(Sim3(cam_from_world_now.Inverse()) *
+                            Sim3(scale, Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero()) *
+                            Sim3(last.cam_from_world));
+}
+
+double System::ReferenceScale(KeyframeId reference) const {
+  return places_ && reference.IsValid() ? places_->KeyframeScale(reference) : 1.0;
+}
+
+Rigid3 System::PoseFromReference(const TrackedPose& pose,
+                                 const Rigid3& reference_cam_from_world) const {
+  Rigid3 cam_from_reference = pose.cam_from_reference;
+  cam_from_reference.translation *= ReferenceScale(pose.reference) / pose.reference_scale;
+  return cam_from_reference * reference_cam_from_world;
 }
 
 std::unique_lock<std::mutex> System::LockPlacesForMapMove() {

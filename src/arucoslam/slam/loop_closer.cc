@@ -137,12 +137,13 @@ Neighbourhoods NeighboursOf(const MapData& data, const std::map<KeyframeId, Sim3
 }
 
 // Edges whose measurement comes from the corrected estimate: the solved loop, every link
-// that fusion created from a corrected keyframe to one outside the corrected set, and the
-// loops closed before (both ends at their current estimate).
+// that fusion created from a corrected keyframe to one outside the corrected set sharing at
+// least `min_weight` points (weaker links would tie the loop through a few fused points), and
+// the loops closed before (both ends at their current estimate).
 std::vector<LoopConstraint> LoopConnections(
     const MapData& data, const std::map<KeyframeId, Sim3>& corrected,
     const Neighbourhoods& before_fusion, const LoopConstraint& loop,
-    const std::vector<std::pair<KeyframeId, KeyframeId>>& previous) {
+    const std::vector<std::pair<KeyframeId, KeyframeId>>& previous, int min_weight) {
   auto estimate = [&](KeyframeId id) {
     const auto it = corrected.find(id);
     return it != corrected.end() ? it->second : Sim3(data.FindKeyframe(id)->cam_from_world);
@@ -151,7 +152,7 @@ std::vector<LoopConstraint> LoopConnections(
   for (const auto& [id, pose] : corrected) {
     if (data.FindKeyframe(id) == nullptr) continue;
     for (const auto& [neighbour, weight] : data.covisibility().Neighbours(id)) {
-      if (corrected.count(neighbour) != 0) continue;
+      if (corrected.count(neighbour) != 0 || weight < min_weight) continue;
       const auto before = before_fusion.find(id);
       if (before != before_fusion.end() && before->second.count(neighbour) != 0) continue;
       constraints.push_back({id, neighbour, estimate(neighbour) * pose.Inverse()});
@@ -247,7 +248,8 @@ LoopClosureResult LoopCloser::CloseLoop(KeyframeId current, KeyframeId candidate
   result.num_fused_points = map_.Write([&](MapData& data) { return ApplyFusion(data, actions); });
   const std::vector<LoopConstraint> constraints = map_.Read([&](const MapData& data) {
     return LoopConnections(data, corrected, before_fusion,
-                           {current, candidate, solved.candidate_from_current}, closed_loops_);
+                           {current, candidate, solved.candidate_from_current}, closed_loops_,
+                           options_.essential_graph.min_covisibility_weight);
   });
   result.num_corrected_keyframes = static_cast<int>(corrected.size());
   result.essential_graph =
