@@ -95,12 +95,14 @@ class PlaceRecognition {
   // kept for culled keyframes). A pose held relative to the keyframe since this was `then`
   // has its offset multiplied by KeyframeScale / then.
   double KeyframeScale(KeyframeId keyframe) const;
+  // Multiplies the keyframes' KeyframeScale by a correction's scale changes (closed loops
+  // here; the System's marker drift corrections from outside).
+  void RecordScaleChanges(const std::map<KeyframeId, double>& changes);
   // Waits for queued keyframes and a running global BA; idempotent.
   void Finish();
 
  private:
   void AddToDatabase(KeyframeId keyframe);
-  void RecordScaleChanges(const std::map<KeyframeId, double>& changes);
   void DetectAndClose(KeyframeId keyframe);
   void RequestGlobalBundleAdjustment();
   void RunGlobalBundleAdjustmentOnce();

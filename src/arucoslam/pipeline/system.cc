@@ -157,9 +157,9 @@ void System::Initialize(Frame& frame, FrameReport& report) {
   if (!init_reference_ ||
       frame.timestamp_s - init_reference_->timestamp_s > options_.max_initialization_gap_s) {
     if (enough) {
+      KeepForBackfill();
       init_reference_ = frame;
       init_reference_fix_ = fix_;
-      initialisation_frames_.clear();
     }
     report.message = enough ? "initialisation reference" : "too few features";
     return;
@@ -177,11 +177,11 @@ void System::Initialize(Frame& frame, FrameReport& report) {
                       result.message);
   if (!result.success) {
     if (result.failure == InitFailure::kTooFewMatches && enough) {
+      KeepForBackfill();
       init_reference_ = frame;
       init_reference_fix_ = fix_;
-      initialisation_frames_.clear();
-    } else if (static_cast<int>(initialisation_frames_.size()) < options_.max_backfill_frames) {
-      initialisation_frames_.push_back(frame);
+    } else {
+      KeepForBackfill(frame);
     }
     return;
   }

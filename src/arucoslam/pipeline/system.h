@@ -257,6 +257,7 @@ class System {
     Rigid3 world_from_cam;
     std::vector<MarkerPoseObservation> markers;  // its inlier markers, undistorted corners
     double nearest_marker_sides = 0.0;           // camera to its nearest marker, in sides
+    bool known_markers_only = true;  // located by markers.json's fixed markers alone
   };
 
   void Initialize(Frame& frame, FrameReport& report);
@@ -334,6 +335,9 @@ class System {
   // The frames kept in initialisation_frames_, tracked from `second` back in time with a
   // tracker of their own: each one tracked gets a pose (system_backfill.cc).
   void BackfillInitialization(const Frame& second, KeyframeId first_id, KeyframeId second_id);
+  // Keeps `frame` (or, without one, the reference about to be replaced) for the backfill;
+  // the oldest frames go beyond max_backfill_frames.
+  void KeepForBackfill(const std::optional<Frame>& frame = std::nullopt);
   // Poses of the current map in its own frame (reference keyframes' final poses).
   std::vector<StampedPose> CurrentMapPoses(bool world_only) const;
   void StartMappingThread();

@@ -1,5 +1,6 @@
 // System's initialisation backfill: the frames a monocular map needed to build up parallax
-// get poses once the map exists, tracked backwards in time from the frame that initialised it.
+// (every frame since the first initialisation reference, also replaced references) get poses
+// once the map exists, tracked backwards in time from the frame that initialised it.
 #include <algorithm>
 #include <utility>
 
@@ -7,6 +8,15 @@
 #include "arucoslam/util/logging.h"
 
 namespace arucoslam {
+
+void System::KeepForBackfill(const std::optional<Frame>& frame) {
+  const std::optional<Frame>& kept = frame ? frame : init_reference_;
+  if (!kept || options_.max_backfill_frames <= 0) return;
+  initialisation_frames_.push_back(*kept);
+  if (static_cast<int>(initialisation_frames_.size()) > options_.max_backfill_frames) {
+    initialisation_frames_.erase(initialisation_frames_.begin());
+  }
+}
 
 void System::BackfillInitialization(const Frame& second, KeyframeId first_id,
                                     KeyframeId second_id) {

@@ -36,10 +36,13 @@ bool System::CorrectDriftWithMarkers(KeyframeId keyframe) {
   std::optional<KeyframePosePrior> own;
   {
     std::lock_guard lock(keyframe_fixes_mutex_);
+    // Mapped markers are estimates of this same map: only markers.json's anchor it.
     const auto found = keyframe_fixes_.find(keyframe);
-    if (found == keyframe_fixes_.end()) return false;
+    if (found == keyframe_fixes_.end() || !found->second.known_markers_only) return false;
     own = MarkerPrior(keyframe, found->second);
-    for (const auto& [id, fix] : keyframe_fixes_) priors.push_back(MarkerPrior(id, fix));
+    for (const auto& [id, fix] : keyframe_fixes_) {
+      if (fix.known_markers_only) priors.push_back(MarkerPrior(id, fix));
+    }
   }
   const std::optional<double> offset_m = map_->Read([&](const MapData& data) -> std::optional<double> {
     const Keyframe* found = data.FindKeyframe(keyframe);
@@ -59,6 +62,7 @@ bool System::CorrectDriftWithMarkers(KeyframeId keyframe) {
                       keyframe.value, *offset_m, sigma_m, result.num_keyframes, result.num_priors,
                       result.summary.BriefReport());
   if (!result.applied) return false;
+  if (places_) places_->RecordScaleChanges(result.scale_changes);
   ++marker_corrections_;
   std::lock_guard lock(stats_mutex_);
   ++stats_.num_marker_corrections;

@@ -62,6 +62,12 @@ std::optional<System::MarkerFix> System::LocateWithMarkers(
     fix.emplace();
     fix->world_from_cam = location.world_from_cam;
     fix->nearest_marker_sides = nearest_sides;
+    fix->known_markers_only = std::all_of(
+        location.marker_ids.begin(), location.marker_ids.end(),
+        [&](int id) {
+          const MarkerInfo* info = options_.marker_map->Find(id);
+          return info != nullptr && info->fixed;
+        });
     for (const MarkerDetection& detection : detections) {
       if (!std::binary_search(location.marker_ids.begin(), location.marker_ids.end(),
                               detection.id)) {

@@ -96,9 +96,9 @@ bool System::InitializeFromMarkers(Frame& frame, FrameReport& report) {
   if (!init_reference_fix_) {
     // A reference with a marker location allows the metric initialisation below.
     if (report.num_features >= options_.initializer.min_matches) {
+      KeepForBackfill();
       init_reference_ = frame;
       init_reference_fix_ = fix_;
-      initialisation_frames_.clear();
       report.message = "initialisation reference (markers)";
       return true;
     }
