@@ -81,11 +81,9 @@ std::shared_ptr<const MarkerMap> System::LocatingMarkers() const {
 void System::ResetMarkerMapping() {
   marker_mapping_live_ = false;
   if (!marker_mapper_) return;
-  // The markers stay (they are in the world frame); the old map's keyframes go.
-  map_->Read([&](const MapData& data) {
-    marker_mapper_->SyncKeyframes(data);
-    return 0;
-  });
+  // The markers stay (they are in the world frame); the old map's keyframes are retired at
+  // their world poses (their marker views still count in the final refinement).
+  marker_mapper_->CloseMap();
 }
 
 void System::FinishMarkerMapping() {
