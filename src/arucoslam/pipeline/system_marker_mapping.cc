@@ -102,7 +102,8 @@ void System::FinishMarkerMapping() {
   if (marker_mapping_live_ && options_.final_marker_bundle_adjustment) {
     const MarkerBundleAdjustmentSummary summary =
         map_->Write([&](MapData& data) { return marker_mapper_->Refine(&data); });
-    ARUCOSLAM_LOG_DEBUG("final bundle adjustment with markers: {}", summary.BriefReport());
+    ARUCOSLAM_LOG_DEBUG("final bundle adjustment with markers ({} views of culled keyframes): {}",
+                        marker_mapper_->NumRetiredViews(), summary.BriefReport());
     return;
   }
   const MarkerBundleAdjustmentSummary summary = marker_mapper_->RefineMarkers();

@@ -71,16 +71,21 @@ MarkerBundleAdjustmentProblem MarkerMapper::BuildProblem(const MapData* map,
     }
   }
   // Retired views: with the map, a pose of its own (free) that only relative marker poses
-  // constrain, so it needs two markers; without, a fixed pose like the live ones.
+  // constrain, so it needs two markers; without, a fixed pose like the live ones. Either
+  // way one of its markers must be a mapped one (known markers do not move).
   const std::size_t min_markers = map != nullptr ? 2 : 1;
   std::map<MarkerId, std::vector<std::pair<std::size_t, const MarkerObservation*>>> retired_views;
   for (const auto& [id, record] : records_) {
     if (record.keyframe.IsValid()) continue;
     std::vector<const MarkerObservation*> seen;
+    bool sees_mapped = false;
     for (const MarkerObservation& observation : record.markers) {
-      if (landmarks_.Contains(observation.marker_id)) seen.push_back(&observation);
+      const MarkerLandmark* landmark = landmarks_.Find(observation.marker_id);
+      if (landmark == nullptr) continue;
+      seen.push_back(&observation);
+      sees_mapped = sees_mapped || !landmark->fixed;
     }
-    if (seen.size() < min_markers) continue;
+    if (seen.size() < min_markers || !sees_mapped) continue;
     const std::size_t pose = add_pose(record.cam_from_world, record.camera, map == nullptr);
     index->retired.push_back(id);
     for (const MarkerObservation* observation : seen) {
