@@ -4,13 +4,14 @@
 #include <stdexcept>
 #include <utility>
 
+#include "arucoslam/slam/marker_candidates.h"
 #include "arucoslam/util/logging.h"
 
 namespace arucoslam {
 
 bool PlaceRecognitionOptions::Check() const {
   return database.Check() && relocalizer.Check() && detector.Check() && closer.Check() &&
-         global_ba.Check() && loop_queue_capacity >= 1;
+         global_ba.Check() && loop_queue_capacity >= 1 && max_marker_candidates >= 0;
 }
 
 PlaceRecognition::PlaceRecognition(Map& map, std::shared_ptr<const Vocabulary> vocabulary,
@@ -62,6 +63,12 @@ std::optional<RelocalizationResult> PlaceRecognition::Relocalize(const Frame& fr
   {
     std::lock_guard lock(database_mutex_);
     if (database_.size() > 0) result = relocalizer_.Relocalize(frame);
+    if (!result && !frame.markers.empty() && options_.max_marker_candidates > 0) {
+      const std::vector<KeyframeId> candidates = map_.Read([&](const MapData& data) {
+        return KeyframesSeeingMarkers(data, frame.markers, options_.max_marker_candidates);
+      });
+      result = relocalizer_.RelocalizeAt(frame, candidates);
+    }
   }
   std::lock_guard lock(*stats_mutex_);
   ++stats_->num_relocalization_attempts;

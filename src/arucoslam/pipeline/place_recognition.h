@@ -34,6 +34,9 @@ struct PlaceRecognitionOptions {
   bool global_bundle_adjustment = true;
   GlobalBundleAdjustmentOptions global_ba;
   int loop_queue_capacity = 64;  // mapped keyframes waiting for the loop-closing thread
+  // Marker ids as place words: when the database finds no pose for a lost frame, up to this
+  // many keyframes that saw the frame's markers (most shared ids first) are tried. 0: off.
+  int max_marker_candidates = 5;
 
   bool Check() const;
 };

@@ -81,11 +81,9 @@ std::shared_ptr<const MarkerMap> System::LocatingMarkers() const {
 void System::ResetMarkerMapping() {
   marker_mapping_live_ = false;
   if (!marker_mapper_) return;
-  // The markers stay (they are in the world frame); the old map's keyframes go.
-  map_->Read([&](const MapData& data) {
-    marker_mapper_->SyncKeyframes(data);
-    return 0;
-  });
+  // The markers stay (they are in the world frame); the old map's keyframes are retired at
+  // their world poses (their marker views still count in the final refinement).
+  marker_mapper_->CloseMap();
 }
 
 void System::FinishMarkerMapping() {
@@ -104,7 +102,8 @@ void System::FinishMarkerMapping() {
   if (marker_mapping_live_ && options_.final_marker_bundle_adjustment) {
     const MarkerBundleAdjustmentSummary summary =
         map_->Write([&](MapData& data) { return marker_mapper_->Refine(&data); });
-    ARUCOSLAM_LOG_DEBUG("final bundle adjustment with markers: {}", summary.BriefReport());
+    ARUCOSLAM_LOG_DEBUG("final bundle adjustment with markers ({} views of culled keyframes): {}",
+                        marker_mapper_->NumRetiredViews(), summary.BriefReport());
     return;
   }
   const MarkerBundleAdjustmentSummary summary = marker_mapper_->RefineMarkers();

@@ -164,6 +164,7 @@ void System::MaybeAlignWorld(Frame* frame) {
   MarkerLandmarks* mapped =
       marker_mapping_live_ ? marker_mapper_->mutable_landmarks() : nullptr;
   map_->Write([&](MapData& data) { ApplyWorldAlignment(world_from_map, &data, mapped); });
+  if (mapped != nullptr) marker_mapper_->ApplySimilarity(world_from_map);
   StartMarkerMapping();
   tracker_->ApplySimilarity(world_from_map);
   const auto to_world = [&](const Rigid3& cam_from_map) {

@@ -1,10 +1,12 @@
-// MarkerMapper: maps markers that the known marker map lacks, online: initialised from IPPE
-// composed with the keyframe pose (a second view settles ambiguous ones), refined by BA.
+// MarkerMapper: maps markers that the known marker map lacks, online: a marker is mapped once
+// several keyframes' IPPE poses of it agree, and refined by BA with the keyframes (culled
+// keyframes' marker views are kept at their last pose and join the final refinement).
 #pragma once
 
 #include <map>
 #include <vector>
 
+#include "arucoslam/geometry/sim3.h"
 #include "arucoslam/map/frame.h"
 #include "arucoslam/map/map_data.h"
 #include "arucoslam/map/marker_landmark.h"
@@ -25,16 +27,27 @@ struct MarkerMapperOptions {
   // A first view whose best IPPE solution reprojects worse than this (RMS, pixels) is not
   // used to initialise (blurred or partly occluded corners).
   double max_initial_rms_px = 2.0;
-  // Views an ambiguous marker may collect before it is initialised from the candidate
-  // that explains all of them best (at least 2: the second view settles the ambiguity).
-  int views_to_resolve_ambiguity = 2;
+  // A marker is mapped (and written) only once this many keyframes saw it at poses that
+  // agree: a false detection of an id rarely repeats at one place (at least 2: a second
+  // view also settles IPPE's ambiguity).
+  int min_consistent_views = 3;
+  // Views agree when the marker centre each one's IPPE pose (composed with the keyframe
+  // pose) gives lies within this of the chosen pose's centre: metres, plus a fraction of
+  // the view's distance (a single view's depth error grows with it).
+  double max_view_disagreement_m = 0.05;
+  double max_view_disagreement_fraction = 0.03;
+  // Views an unmapped marker keeps (the oldest are dropped first).
+  int max_pending_views = 30;
   // Corner noise given to the bundle adjustment, pixels.
   double corner_sigma_px = 1.0;
   MarkerBundleAdjustmentOptions bundle_adjustment;
 
   bool Check() const {
     return unknown_marker_size_m >= 0.0 && marker_pose.Check() && max_initial_rms_px > 0.0 &&
-           views_to_resolve_ambiguity >= 2 && corner_sigma_px > 0.0 && bundle_adjustment.Check();
+           min_consistent_views >= 2 && max_view_disagreement_m > 0.0 &&
+           max_view_disagreement_fraction >= 0.0 &&
+           max_pending_views >= min_consistent_views && corner_sigma_px > 0.0 &&
+           bundle_adjustment.Check();
   }
 };
 
@@ -48,52 +61,83 @@ class MarkerMapper {
   std::vector<MarkerId> AddKeyframe(KeyframeId keyframe, const Rigid3& cam_from_world,
                                     const CameraModel& camera,
                                     const std::vector<MarkerObservation>& markers);
-  // Forgets a keyframe (culled by the local mapper).
+  // Forgets a keyframe and every marker view it gave.
   void EraseKeyframe(KeyframeId keyframe);
-  // Takes the current pose of every recorded keyframe from `map` (optimisation moved them)
-  // and forgets the ones `map` no longer holds (culled, or the map was reset).
+  // Takes the current pose of every recorded keyframe from `map` (optimisation moved them);
+  // the ones `map` no longer holds (culled) are retired: their marker views stay, at the
+  // last pose, for pending markers and the final refinement.
   void SyncKeyframes(const MapData& map);
+  // The map was replaced: every recorded keyframe is retired (its pose is in the world) and
+  // later similarity moves no longer apply to them.
+  void CloseMap();
+  // The current map was moved by `new_from_old` (a world re-alignment): the recorded poses
+  // of its keyframes, live and retired, move with it. (The landmarks are moved by the caller.)
+  void ApplySimilarity(const Sim3& new_from_old);
 
   // Bundle adjustment of every keyframe and point of `map` with the marker observations:
   // known markers fixed, mapped ones estimated. Poses, points and marker poses are written
   // back on success (the keyframe poses this mapper keeps too). One camera for all.
   MarkerBundleAdjustmentSummary Refine(MapData* map);
-  // Refines only the mapped markers against the recorded keyframe poses (held fixed).
+  // Refines only the mapped markers against the recorded keyframe poses, live and retired
+  // (held fixed).
   MarkerBundleAdjustmentSummary RefineMarkers();
 
   const MarkerLandmarks& landmarks() const { return landmarks_; }
   // For optimisations that estimate the mapped markers with the keyframes (local BA).
   MarkerLandmarks* mutable_landmarks() { return &landmarks_; }
-  bool Records(KeyframeId keyframe) const { return keyframes_.count(keyframe) > 0; }
+  bool Records(KeyframeId keyframe) const { return live_.count(keyframe) > 0; }
+  int NumRetiredViews() const;
   // Known and mapped markers (mapped ones with fixed: false); pending ones are left out.
   MarkerMap ToMarkerMap() const;
   int NumPending() const { return static_cast<int>(pending_.size()); }
 
  private:
-  struct KeyframeRecord {
+  // A keyframe's pose and marker views; `keyframe` is invalid once it is retired.
+  struct Record {
+    KeyframeId keyframe;
+    int generation = 0;  // the map it belonged to (see CloseMap)
     Rigid3 cam_from_world;
     CameraModel camera;
+    std::vector<MarkerObservation> markers;
   };
   struct View {
-    KeyframeId keyframe;
+    int record = 0;  // into records_
     std::array<Eigen::Vector2d, 4> corners_px;
     MarkerPose pose;  // IPPE in that view
   };
 
-  void Observe(KeyframeId keyframe, const MarkerObservation& observation,
+  void Observe(int record, const MarkerObservation& observation,
                std::vector<MarkerId>* initialised);
-  // Initialises a pending marker when its views allow it; true when it did.
+  void Retire(KeyframeId keyframe);
+  // Initialises a pending marker when enough of its views agree; true when it did.
   bool TryInitialise(MarkerId id);
-  double ViewsSquaredError(const std::vector<View>& views, const Rigid3& world_from_marker) const;
-  MarkerBundleAdjustmentProblem BuildProblem(const MapData* map, std::vector<KeyframeId>* poses,
-                                             std::vector<MapPointId>* points,
-                                             std::vector<MarkerId>* markers) const;
+  // Views whose own IPPE marker centre lies near `world_from_marker`'s.
+  std::vector<const View*> AgreeingViews(const std::vector<View>& views,
+                                         const Rigid3& world_from_marker) const;
+  double ViewsSquaredError(const std::vector<const View*>& views,
+                           const Rigid3& world_from_marker) const;
+  // Bundle adjustment of one new marker against its views' poses (fixed).
+  Rigid3 RefineNewMarker(const Rigid3& initial, const std::vector<const View*>& views) const;
+  // What each pose, point and marker of a built problem is: the live keyframes' poses come
+  // first, then the retired records'.
+  struct ProblemIndex {
+    std::vector<KeyframeId> keyframes;
+    std::vector<int> retired;
+    std::vector<MapPointId> points;
+    std::vector<MarkerId> markers;
+  };
+  // With `map`: its keyframes and points, free, and the retired views that see two markers
+  // or more (free poses). Without: the recorded poses, live and retired, fixed.
+  MarkerBundleAdjustmentProblem BuildProblem(const MapData* map, ProblemIndex* index) const;
 
   MarkerMapperOptions options_;
   std::string dictionary_;
   double unknown_size_ = 0.0;
   MarkerLandmarks landmarks_;
-  std::map<KeyframeId, KeyframeRecord> keyframes_;
+  std::map<int, Record> records_;         // every keyframe recorded, live or retired
+  std::map<KeyframeId, int> live_;         // live keyframe -> its record
+  int next_record_ = 0;
+  int generation_ = 0;
   std::map<MarkerId, std::vector<View>> pending_;
 };
 

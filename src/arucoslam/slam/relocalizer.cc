@@ -219,11 +219,40 @@ std::optional<RelocalizationResult> Relocalizer::Relocalize(const Frame& frame,
   return std::nullopt;
 }
 
+std::optional<RelocalizationResult> Relocalizer::RelocalizeAt(
+    const Frame& frame, const std::vector<KeyframeId>& candidates,
+    RelocalizationStats* stats) const {
+  RelocalizationStats local_stats;
+  RelocalizationStats& s = stats != nullptr ? *stats : local_stats;
+  s = {};
+  if (frame.features.empty() || frame.features.undistorted.size() != frame.features.size()) {
+    return std::nullopt;
+  }
+  const ImageWords words = database_.Transform(frame.features.descriptors);
+  for (const KeyframeId& candidate : candidates) {
+    std::optional<FeatureVector> own;
+    if (database_.Direct(candidate) == nullptr) {
+      own = map_.Read([&](const MapData& data) -> std::optional<FeatureVector> {
+        const Keyframe* keyframe = data.FindKeyframe(candidate);
+        if (keyframe == nullptr) return std::nullopt;
+        return database_.Transform(keyframe->features.descriptors).direct;
+      });
+      if (!own) continue;
+    }
+    ++s.num_candidates;
+    std::optional<RelocalizationResult> result =
+        Verify(frame, words.direct, candidate, &s, own ? &*own : nullptr);
+    if (result) return result;
+  }
+  return std::nullopt;
+}
+
 std::optional<RelocalizationResult> Relocalizer::Verify(const Frame& frame,
                                                         const FeatureVector& direct,
                                                         KeyframeId candidate,
-                                                        RelocalizationStats* stats) const {
-  const FeatureVector* keyframe_direct = database_.Direct(candidate);
+                                                        RelocalizationStats* stats,
+                                                        const FeatureVector* keyframe_direct) const {
+  if (keyframe_direct == nullptr) keyframe_direct = database_.Direct(candidate);
   if (keyframe_direct == nullptr) return std::nullopt;
   Correspondences matched(frame.features.size());
   std::vector<KeyframeId> local{candidate};

@@ -71,13 +71,20 @@ class Relocalizer {
   std::optional<RelocalizationResult> Relocalize(const Frame& frame,
                                                  RelocalizationStats* stats = nullptr) const;
 
+  // The same with candidate keyframes found another way (shared marker ids), verified in
+  // turn; a candidate the database does not hold yet is matched with its own words.
+  std::optional<RelocalizationResult> RelocalizeAt(const Frame& frame,
+                                                   const std::vector<KeyframeId>& candidates,
+                                                   RelocalizationStats* stats = nullptr) const;
+
   // The candidate keyframes for a BoW vector, best group first (exposed for tests).
   std::vector<KeyframeId> Candidates(const BowVector& bow, int* num_matches = nullptr) const;
 
  private:
+  // `keyframe_direct`: the candidate's words when the database does not hold them.
   std::optional<RelocalizationResult> Verify(const Frame& frame, const FeatureVector& direct,
-                                             KeyframeId candidate,
-                                             RelocalizationStats* stats) const;
+                                             KeyframeId candidate, RelocalizationStats* stats,
+                                             const FeatureVector* keyframe_direct = nullptr) const;
 
   const Map& map_;
   const KeyframeDatabase& database_;
