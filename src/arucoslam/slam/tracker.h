@@ -67,7 +67,7 @@ struct TrackerOptions {
 
 struct TrackingResult {
   TrackingState state = TrackingState::kNotInitialized;
-  std::string method;  // "motion", "reference" or "" when no pose
+  std::string method;  // "motion", "reference", "prediction", "pose" or "" when no pose
   int num_initial_matches = 0;
   int num_initial_inliers = 0;
   int num_local_map_matches = 0;  // matches added by the local-map search
