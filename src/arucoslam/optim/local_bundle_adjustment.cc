@@ -1,5 +1,6 @@
 #include "arucoslam/optim/local_bundle_adjustment.h"
 
+#include <algorithm>
 #include <map>
 #include <set>
 #include <vector>
@@ -13,6 +14,13 @@ struct Snapshot {
   std::vector<KeyframeId> keyframe_ids;  // per problem pose
   std::vector<MapPointId> point_ids;     // per problem point
   std::vector<int> keypoint_indices;     // per observation
+  // Observations left out as too near their keyframe: (keyframe, point, keypoint index).
+  struct Excluded {
+    KeyframeId keyframe;
+    MapPointId point;
+    int index = 0;
+  };
+  std::vector<Excluded> too_near;
   int num_local = 0;
   int num_fixed = 0;
 };
@@ -41,6 +49,19 @@ std::set<KeyframeId> ChooseFixed(const MapData& data, KeyframeId current,
   }
   if (anchors < options.min_fixed_keyframes) fixed.insert(current);
   return fixed;
+}
+
+// Median depth of the points a keyframe observes (0 when it has none).
+double MedianPointDepth(const MapData& data, const Keyframe& keyframe) {
+  std::vector<double> depths;
+  for (const MapPointId& id : keyframe.map_point_ids) {
+    if (const MapPoint* point = data.FindMapPoint(id)) {
+      depths.push_back((keyframe.cam_from_world * point->p_in_world).z());
+    }
+  }
+  if (depths.empty()) return 0.0;
+  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
+  return depths[depths.size() / 2];
 }
 
 Snapshot TakeSnapshot(const MapData& data, KeyframeId current,
@@ -79,13 +100,29 @@ Snapshot TakeSnapshot(const MapData& data, KeyframeId current,
       snapshot.keyframe_ids.push_back(id);
     }
   }
+  std::map<KeyframeId, double> min_depth;  // per observer: min_relative_depth x median depth
+  for (const auto& [id, index] : pose_index) {
+    min_depth[id] = options.min_relative_depth * MedianPointDepth(data, *data.FindKeyframe(id));
+  }
+  std::vector<std::pair<KeyframeId, int>> kept;
   for (const MapPointId& point_id : points) {
     const MapPoint* point = data.FindMapPoint(point_id);
+    kept.clear();
+    for (const auto& [observer, index] : point->observations) {
+      const double depth =
+          (data.FindKeyframe(observer)->cam_from_world * point->p_in_world).z();
+      if (depth <= 0.0 || depth < min_depth.at(observer)) {
+        snapshot.too_near.push_back({observer, point_id, index});
+      } else {
+        kept.emplace_back(observer, index);
+      }
+    }
+    if (kept.empty()) continue;
     const std::size_t point_index = snapshot.problem.points.size();
     // One view cannot place a point (its depth is free): it is held, constraining the pose.
-    snapshot.problem.points.push_back({point->p_in_world, point->observations.size() < 2});
+    snapshot.problem.points.push_back({point->p_in_world, kept.size() < 2});
     snapshot.point_ids.push_back(point_id);
-    for (const auto& [observer, index] : point->observations) {
+    for (const auto& [observer, index] : kept) {
       const Keyframe* observer_keyframe = data.FindKeyframe(observer);
       snapshot.problem.observations.push_back({pose_index.at(observer), point_index,
                                                observer_keyframe->UndistortedPixel(index),
@@ -108,6 +145,17 @@ int WriteBack(MapData& data, const Snapshot& snapshot, const BundleAdjustmentSum
   }
   int erased = 0;
   if (erase_outliers) {
+    for (const Snapshot::Excluded& excluded : snapshot.too_near) {
+      const MapPoint* point = data.FindMapPoint(excluded.point);
+      if (point == nullptr) continue;
+      const auto it = point->observations.find(excluded.keyframe);
+      if (it == point->observations.end() || it->second != excluded.index) continue;
+      data.EraseObservation(excluded.keyframe, excluded.point);
+      if (data.FindMapPoint(excluded.point)->observations.empty()) {
+        data.EraseMapPoint(excluded.point);
+      }
+      ++erased;
+    }
     for (std::size_t k = 0; k < problem.observations.size(); ++k) {
       if (!summary.outliers[k]) continue;
       const KeyframeId keyframe_id = snapshot.keyframe_ids[problem.observations[k].pose_index];
@@ -152,6 +200,7 @@ LocalBundleAdjustmentResult RunLocalBundleAdjustment(Map& map, KeyframeId keyfra
   result.num_local_keyframes = snapshot.num_local;
   result.num_fixed_keyframes = snapshot.num_fixed;
   result.num_points = static_cast<int>(snapshot.problem.points.size());
+  result.num_too_near_observations = static_cast<int>(snapshot.too_near.size());
   if (snapshot.problem.observations.empty()) {
     result.summary.message = "no observations in the local window";
     return result;

@@ -24,12 +24,17 @@ struct LocalBundleAdjustmentOptions {
   // Erase observations the solve flags as outliers (chi-square test); points left with no
   // observation are erased.
   bool erase_outliers = true;
+  // An observation whose point lies closer to the keyframe than this fraction of the
+  // keyframe's median point depth (or behind it) is left out of the solve and erased with
+  // the outliers: such points (bad matches placed next to a camera centre) have Jacobians
+  // 1e4 times the others' and made Ceres' dense Cholesky fail.
+  double min_relative_depth = 0.1;
   // Marker-corner residuals of the window's keyframes (when markers are given).
   MarkerFactorOptions markers;
 
   bool Check() const {
     return solver.Check() && max_covisible_keyframes >= 0 && min_fixed_keyframes >= 0 &&
-           min_anchor_points >= 0 && markers.Check();
+           min_anchor_points >= 0 && min_relative_depth >= 0.0 && markers.Check();
   }
 };
 
@@ -39,6 +44,7 @@ struct LocalBundleAdjustmentResult {
   int num_fixed_keyframes = 0;
   int num_points = 0;
   int num_erased_observations = 0;
+  int num_too_near_observations = 0;  // left out for min_relative_depth (erased with outliers)
   int num_marker_observations = 0;  // marker-corner residual blocks (8-vectors)
   int num_moved_markers = 0;        // non-fixed markers whose pose was updated
   BundleAdjustmentSummary summary;

@@ -199,6 +199,46 @@ TEST(LocalBundleAdjustmentTest, ErasesOutlierObservations) {
   EXPECT_EQ(scene.map.Read([](const MapData& data) { return data.CheckInvariants(); }), "");
 }
 
+// Points moved next to a window keyframe's centre (2% of its median depth, as bad matches
+// triangulated there): their observations are left out of the solve and erased, the rest
+// of the window converges as without them. Included, these made Ceres' Cholesky fail.
+TEST(LocalBundleAdjustmentTest, PointsNextToACameraAreLeftOut) {
+  SyntheticMap scene;
+  Build(scene, 0);
+  const int num_near = 5;
+  std::vector<MapPointId> near;
+  scene.map.Write([&](MapData& data) {
+    const Keyframe& keyframe = *data.FindKeyframe(scene.keyframes[9]);
+    const Rigid3 world_from_cam = keyframe.cam_from_world.Inverse();
+    for (int k = 0; k < num_near; ++k) {
+      const MapPointId id = keyframe.map_point_ids[10 * k];
+      const Eigen::Vector3d p_in_world = data.FindMapPoint(id)->p_in_world;
+      const double depth = (keyframe.cam_from_world * p_in_world).z();
+      // The same ray from the camera, at 2% of the depth.
+      const Eigen::Vector3d near_point =
+          world_from_cam.translation + 0.02 * (p_in_world - world_from_cam.translation);
+      ASSERT_GT(depth, 1.0);
+      data.SetMapPointPosition(id, near_point);
+      near.push_back(id);
+    }
+  });
+  LocalBundleAdjustmentOptions options;
+  options.max_covisible_keyframes = 5;
+  const LocalBundleAdjustmentResult result =
+      RunLocalBundleAdjustment(scene.map, scene.keyframes[9], options);
+  ASSERT_TRUE(result.applied) << result.summary.message;
+  // Each moved point is too near keyframe 9 and behind or too near most others.
+  EXPECT_GE(result.num_too_near_observations, num_near);
+  scene.map.Read([&](const MapData& data) {
+    const Keyframe& keyframe = *data.FindKeyframe(scene.keyframes[9]);
+    for (const MapPointId& id : near) {
+      EXPECT_EQ(std::count(keyframe.map_point_ids.begin(), keyframe.map_point_ids.end(), id), 0);
+    }
+  });
+  EXPECT_LT(MaxPoseError(scene, 4, 9), 0.005);
+  EXPECT_EQ(scene.map.Read([](const MapData& data) { return data.CheckInvariants(); }), "");
+}
+
 // Another thread erases points and a window keyframe while the solve runs without the
 // lock: the write-back must skip what is gone and leave a consistent map.
 TEST(LocalBundleAdjustmentTest, ConcurrentErasuresDuringTheSolve) {

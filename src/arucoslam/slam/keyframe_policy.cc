@@ -6,7 +6,7 @@ bool KeyframePolicyOptions::Check() const {
   return min_frames_between >= 0 && max_frames_between >= min_frames_between &&
          tracked_ratio > 0.0 && tracked_ratio <= 1.0 && min_observations >= 1 &&
          min_tracked_points >= 0 && weak_ratio >= 0.0 && weak_ratio <= tracked_ratio &&
-         weak_tracked_points >= 0;
+         weak_tracked_points >= 0 && weak_min_frames_between >= 1;
 }
 
 KeyframeDecision DecideKeyframe(const KeyframePolicyOptions& options,
@@ -20,7 +20,8 @@ KeyframeDecision DecideKeyframe(const KeyframePolicyOptions& options,
   if (input.mapper_idle && may_when_idle) return {true, "ratio"};
   const bool weak = input.num_tracked < options.weak_ratio * input.num_reference_tracked ||
                     input.num_tracked < options.weak_tracked_points;
-  if (weak && input.frames_since_last_keyframe >= 1 && input.mapper_has_room) {
+  if (weak && input.frames_since_last_keyframe >= options.weak_min_frames_between &&
+      input.mapper_has_room) {
     return {true, "weak"};
   }
   if (waited_long && input.mapper_has_room) return {true, "max-frames"};

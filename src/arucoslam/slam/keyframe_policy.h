@@ -30,6 +30,10 @@ struct KeyframePolicyOptions {
   // points are triangulated before the old ones leave the view.
   double weak_ratio = 0.5;
   int weak_tracked_points = 100;
+  // Frames that must pass between two weak keyframes. With 1 a turn made every frame a
+  // keyframe: local BA's window (20 keyframes) then spanned 0.7 s of the turn, its fixed
+  // keyframes too, and the scale drifted with the turn's low-parallax points.
+  int weak_min_frames_between = 3;
 
   bool Check() const;
 };

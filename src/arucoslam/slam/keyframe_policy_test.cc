@@ -53,6 +53,7 @@ TEST(KeyframePolicy, WeakTrackingInsertsWithoutWaiting) {
   options.min_frames_between = 4;
   options.weak_ratio = 0.5;
   options.weak_tracked_points = 100;
+  options.weak_min_frames_between = 1;
   // Normal ratio drop: waits for min_frames_between.
   EXPECT_EQ(DecideKeyframe(options, Input(1, 150, 200, true)).reason, "too-soon");
   EXPECT_EQ(DecideKeyframe(options, Input(4, 150, 200, true)).reason, "ratio");
@@ -67,6 +68,20 @@ TEST(KeyframePolicy, WeakTrackingInsertsWithoutWaiting) {
   EXPECT_EQ(DecideKeyframe(options, Input(0, 99, 400, true)).reason, "too-soon");
   EXPECT_EQ(DecideKeyframe(options, Input(3, 15, 400, true)).reason, "too-few");
   options.weak_ratio = 0.95;  // above tracked_ratio
+  EXPECT_FALSE(options.Check());
+}
+
+// Weak keyframes (turns) are spaced by weak_min_frames_between (3 by default), still before
+// min_frames_between.
+TEST(KeyframePolicy, WeakKeyframesAreSpaced) {
+  KeyframePolicyOptions options;
+  options.min_frames_between = 4;
+  ASSERT_EQ(options.weak_min_frames_between, 3);
+  EXPECT_EQ(DecideKeyframe(options, Input(1, 99, 400, true)).reason, "too-soon");
+  EXPECT_EQ(DecideKeyframe(options, Input(2, 99, 400, true)).reason, "too-soon");
+  EXPECT_EQ(DecideKeyframe(options, Input(3, 99, 400, true)).reason, "weak");
+  EXPECT_EQ(DecideKeyframe(options, Input(2, 99, 400, false)).reason, "busy");
+  options.weak_min_frames_between = 0;
   EXPECT_FALSE(options.Check());
 }
 

@@ -1,6 +1,7 @@
 #include "arucoslam/slam/tracker.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <map>
 #include <set>
@@ -39,7 +40,10 @@ bool TrackerOptions::Check() const {
   return motion_search.Check() && min_motion_matches >= 0 && reference_search.Check() &&
          min_reference_matches >= 0 && covisible_per_keyframe >= 0 && max_local_keyframes >= 1 &&
          local_map_search.Check() && min_view_cos >= -1.0 && min_view_cos <= 1.0 &&
-         recovery_frames >= 0 && min_pose_inliers >= 3 && min_local_map_inliers >= min_pose_inliers && pose.Check() &&
+         recovery_frames >= 0 && min_pose_inliers >= 3 && min_local_map_inliers >= min_pose_inliers &&
+         min_weak_inliers >= min_pose_inliers && min_weak_inliers <= min_local_map_inliers &&
+         weak_max_rotation_deg >= 0.0 && weak_max_center_steps >= 0.0 &&
+         weak_radius_factor >= 1.0 && pose.Check() &&
          marker_pose.Check() && relocalization_min_axis_cos >= -1.0 &&
          relocalization_min_axis_cos <= 1.0;
 }
@@ -74,13 +78,18 @@ TrackingResult Tracker::Track(Frame& frame, const std::vector<MarkerPoseObservat
   if (state_ == TrackingState::kNotInitialized || !last_frame_) return result;
   frame.ResetMatches();
   frame.cam_from_world.reset();
+  const int steps = frames_lost_ + 1;
   bool ok = false;
-  if (velocity_) ok = TrackWithMotionModel(frame, result, frames_lost_ + 1);
+  if (velocity_) ok = TrackWithMotionModel(frame, result, steps);
   if (!ok) {
     frame.ResetMatches();
     ok = TrackReferenceKeyframe(frame, result);
   }
   if (ok) ok = TrackLocalMap(frame, result);
+  if (!ok && velocity_) {
+    frame.ResetMatches();
+    ok = TrackFromPrediction(frame, result, steps);
+  }
   if (!ok) {
     frame.cam_from_world.reset();
     if (++frames_lost_ > options_.recovery_frames) velocity_.reset();
@@ -100,9 +109,33 @@ TrackingResult Tracker::Track(Frame& frame, const std::vector<MarkerPoseObservat
   return result;
 }
 
-bool Tracker::TrackWithMotionModel(Frame& frame, TrackingResult& result, int steps) {
+Rigid3 Tracker::Predict(int steps) const {
   Rigid3 predicted = *last_frame_->cam_from_world;
   for (int k = 0; k < steps; ++k) predicted = *velocity_ * predicted;
+  return predicted;
+}
+
+bool Tracker::AgreesWithPrediction(const Rigid3& cam_from_world, int steps) const {
+  if (!velocity_) return false;
+  const Rigid3 predicted = Predict(steps);
+  const double rotation_deg =
+      predicted.rotation.angularDistance(cam_from_world.rotation) * 180.0 / M_PI;
+  const double center_error =
+      (predicted.Inverse().translation - cam_from_world.Inverse().translation).norm();
+  const double step_length = velocity_->translation.norm();
+  return rotation_deg <= options_.weak_max_rotation_deg * steps &&
+         center_error <= options_.weak_max_center_steps * step_length * steps;
+}
+
+bool Tracker::TrackFromPrediction(Frame& frame, TrackingResult& result, int steps) {
+  frame.cam_from_world = Predict(steps);
+  result = TrackingResult{state_, "prediction", 0, 0, 0, 0};
+  // Recovering: the prediction is older, the window twice as wide (as in the motion model).
+  return TrackLocalMap(frame, result, options_.weak_radius_factor * (steps > 1 ? 2.0 : 1.0));
+}
+
+bool Tracker::TrackWithMotionModel(Frame& frame, TrackingResult& result, int steps) {
+  const Rigid3 predicted = Predict(steps);
   ProjectionQueries set;
   map_.Read([&](const MapData& data) {
     for (std::size_t i = 0; i < last_frame_->map_point_ids.size(); ++i) {
@@ -199,7 +232,7 @@ TrackingResult Tracker::TrackFromPose(Frame& frame, const Rigid3& cam_from_world
   result.num_initial_inliers = OptimizeFramePose(frame, cam_from_world);
   result.method = "pose";
   if (result.num_initial_inliers < options_.min_pose_inliers ||
-      !TrackLocalMap(frame, result)) {
+      !TrackLocalMap(frame, result, 1.0, /*allow_weak=*/false)) {
     frame.cam_from_world.reset();
     frame.ResetMatches();
     result.method.clear();

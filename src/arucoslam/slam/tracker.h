@@ -44,6 +44,16 @@ struct TrackerOptions {
   // Inliers needed after the first pose optimisation and after the local map.
   int min_pose_inliers = 10;
   int min_local_map_inliers = 30;
+  // Weak views (a turn facing a bland wall): a frame with fewer inliers than
+  // min_local_map_inliers but at least min_weak_inliers still counts as tracked when its pose
+  // agrees with the motion model's prediction (rotation within weak_max_rotation_deg, camera
+  // centre within weak_max_center_steps frame motions of it). The motion model is also
+  // trusted alone: when the last frame's points give too few matches, the local map is
+  // searched from the predicted pose with a window weak_radius_factor times wider.
+  int min_weak_inliers = 15;
+  double weak_max_rotation_deg = 2.0;
+  double weak_max_center_steps = 2.0;
+  double weak_radius_factor = 2.0;
   PoseOptimizationOptions pose;
   // Marker-corner residuals used with the keypoints when known markers are given to Track
   // (their keypoint part is `pose`, overwritten here).
@@ -57,7 +67,7 @@ struct TrackerOptions {
 
 struct TrackingResult {
   TrackingState state = TrackingState::kNotInitialized;
-  std::string method;  // "motion", "reference" or "" when no pose
+  std::string method;  // "motion", "reference", "prediction", "pose" or "" when no pose
   int num_initial_matches = 0;
   int num_initial_inliers = 0;
   int num_local_map_matches = 0;  // matches added by the local-map search
@@ -103,7 +113,15 @@ class Tracker {
   // `steps`: frames since the last tracked one (1 while tracking).
   bool TrackWithMotionModel(Frame& frame, TrackingResult& result, int steps);
   bool TrackReferenceKeyframe(Frame& frame, TrackingResult& result);
-  bool TrackLocalMap(Frame& frame, TrackingResult& result);
+  // `radius_factor` widens the projection search (a pose predicted, not optimised);
+  // `allow_weak`: min_weak_inliers suffice when the pose agrees with the motion model.
+  bool TrackLocalMap(Frame& frame, TrackingResult& result, double radius_factor = 1.0,
+                     bool allow_weak = true);
+  // Tracks the local map from the motion model's prediction alone (few motion matches).
+  bool TrackFromPrediction(Frame& frame, TrackingResult& result, int steps);
+  // Whether a weakly tracked pose agrees with the motion model's prediction.
+  bool AgreesWithPrediction(const Rigid3& cam_from_world, int steps) const;
+  Rigid3 Predict(int steps) const;
   // Pose-only optimisation over the frame's matches from `initial`; drops outlier matches
   // and returns the number of inliers (0 when it failed).
   int OptimizeFramePose(Frame& frame, const Rigid3& initial);

@@ -13,12 +13,12 @@
 namespace arucoslam {
 namespace {
 
-// Keyframes observing the frame's matched points, most votes first, then best covisible
+// Keyframes observing `voters` (the frame's matched points), most votes first, then best covisible
 // neighbours of each; the first one is the frame's natural reference keyframe.
-std::vector<KeyframeId> LocalKeyframes(const MapData& data, const Frame& frame,
+std::vector<KeyframeId> LocalKeyframes(const MapData& data, const std::vector<MapPointId>& voters,
                                        const TrackerOptions& options) {
   std::map<KeyframeId, int> votes;
-  for (const MapPointId& id : frame.map_point_ids) {
+  for (const MapPointId& id : voters) {
     if (const MapPoint* point = data.FindMapPoint(id)) {
       for (const auto& [keyframe, index] : point->observations) ++votes[keyframe];
     }
@@ -48,7 +48,7 @@ std::vector<KeyframeId> LocalKeyframes(const MapData& data, const Frame& frame,
 // (through `visible`) every point predicted in view, matched ones included.
 ProjectionQueries LocalPointQueries(const MapData& data, const Frame& frame,
                                     const std::vector<KeyframeId>& local,
-                                    const TrackerOptions& options,
+                                    const TrackerOptions& options, double radius_factor,
                                     std::vector<MapPointId>* visible) {
   std::set<MapPointId> matched;
   for (const MapPointId& id : frame.map_point_ids) {
@@ -74,7 +74,8 @@ ProjectionQueries LocalPointQueries(const MapData& data, const Frame& frame,
       const double view_cos = point.normal.dot(ray) / distance;
       if (view_cos < options.min_view_cos) continue;
       const int level = point.PredictLevel(distance, frame.features.pyramid);
-      set.Add(id, *pixel, level, point.descriptor, view_cos > 0.998 ? 2.5 : 4.0, -1.0f);
+      set.Add(id, *pixel, level, point.descriptor, (view_cos > 0.998 ? 2.5 : 4.0) * radius_factor,
+              -1.0f);
       visible->push_back(id);
     }
   }
@@ -84,13 +85,19 @@ ProjectionQueries LocalPointQueries(const MapData& data, const Frame& frame,
 
 }  // namespace
 
-bool Tracker::TrackLocalMap(Frame& frame, TrackingResult& result) {
+bool Tracker::TrackLocalMap(Frame& frame, TrackingResult& result, double radius_factor,
+                            bool allow_weak) {
   std::vector<MapPointId> visible;
   ProjectionQueries set;
+  // A frame with no matches yet (pose predicted) takes its local map from the last frame.
+  bool has_matches = false;
+  for (const MapPointId& id : frame.map_point_ids) has_matches = has_matches || id.IsValid();
+  const std::vector<MapPointId>& voters =
+      has_matches || !last_frame_ ? frame.map_point_ids : last_frame_->map_point_ids;
   map_.Read([&](const MapData& data) {
-    const std::vector<KeyframeId> local = LocalKeyframes(data, frame, options_);
+    const std::vector<KeyframeId> local = LocalKeyframes(data, voters, options_);
     if (!local.empty()) reference_keyframe_ = local.front();
-    set = LocalPointQueries(data, frame, local, options_, &visible);
+    set = LocalPointQueries(data, frame, local, options_, radius_factor, &visible);
   });
   std::vector<bool> taken(frame.features.size(), false);
   for (std::size_t i = 0; i < frame.map_point_ids.size(); ++i) {
@@ -107,7 +114,9 @@ bool Tracker::TrackLocalMap(Frame& frame, TrackingResult& result) {
       if (id.IsValid()) data.IncreaseFound(id);
     }
   });
-  return result.num_inliers >= options_.min_local_map_inliers;
+  if (result.num_inliers >= options_.min_local_map_inliers) return true;
+  return allow_weak && result.num_inliers >= options_.min_weak_inliers && frame.cam_from_world &&
+         AgreesWithPrediction(*frame.cam_from_world, frames_lost_ + 1);
 }
 
 }  // namespace arucoslam

@@ -39,7 +39,9 @@ class SyntheticWorld {
   }
 
   // Frame t; `truth_point` gets the world point index of each keypoint (-1: distractor).
-  Frame MakeFrame(int t, std::vector<int>* truth_point, bool unrelated = false) {
+  // `max_points`: only the first this many visible points are seen (a bland view).
+  Frame MakeFrame(int t, std::vector<int>* truth_point, bool unrelated = false,
+                  std::size_t max_points = 100000) {
     const CameraModel camera = TestCamera();
     const Rigid3 cam_from_world = CamFromWorld(t);
     std::normal_distribution<double> noise(0.0, 0.3);
@@ -53,6 +55,7 @@ class SyntheticWorld {
     for (std::size_t j = 0; j < points_.size() && !unrelated; ++j) {
       const auto pixel = camera.Project(cam_from_world * points_[j]);
       if (!pixel || !camera.InImage(*pixel, 20.0)) continue;
+      if (entries.size() >= max_points) break;
       OrbDescriptor d = descriptors_[j];
       for (int flip = 0; flip < 3; ++flip) {
         const int bit = static_cast<int>(random_() % 256);
@@ -238,6 +241,41 @@ void LoseOneFrameAndRecover(int recovery_frames, const std::string& expected_met
 TEST(TrackerTest, LostOnAnUnrelatedFrameThenRecovers) {
   LoseOneFrameAndRecover(15, "motion");
   LoseOneFrameAndRecover(0, "reference");
+}
+
+// Three bland frames that see only 22 of the map's points (fewer than the 30 inliers
+// min_local_map_inliers asks for): tracked because their poses agree with the motion model,
+// to centimetres; with the weak path off (min_weak_inliers 30) the first of them is lost.
+int TrackThroughSparseFrames(const TrackerOptions& options, double* worst_error) {
+  SyntheticWorld world(4);
+  Map map;
+  Frame start;
+  const KeyframeId reference = BuildInitialMap(world, map, &start);
+  Tracker tracker(map, options);
+  tracker.Start(start, reference);
+  std::vector<int> truth;
+  int tracked = 0;
+  *worst_error = 0.0;
+  for (int t = 6; t <= 12; ++t) {
+    const bool sparse = t >= 9 && t <= 11;
+    Frame frame = world.MakeFrame(t, &truth, false, sparse ? 22 : 100000);
+    const TrackingResult result = tracker.Track(frame);
+    if (result.state != TrackingState::kTracking) continue;
+    ++tracked;
+    *worst_error = std::max(*worst_error,
+                            PositionError(*frame.cam_from_world, world.CamFromWorld(t)));
+    if (sparse) EXPECT_LT(result.num_inliers, options.min_local_map_inliers) << t;
+  }
+  return tracked;
+}
+
+TEST(TrackerTest, WeakFramesAgreeingWithTheMotionModelAreTracked) {
+  double worst = 0.0;
+  EXPECT_EQ(TrackThroughSparseFrames(TrackerOptions{}, &worst), 7);
+  EXPECT_LT(worst, 0.02);
+  TrackerOptions strict;
+  strict.min_weak_inliers = strict.min_local_map_inliers;
+  EXPECT_LT(TrackThroughSparseFrames(strict, &worst), 7);
 }
 
 }  // namespace
