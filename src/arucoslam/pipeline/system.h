@@ -82,7 +82,7 @@ struct SystemOptions {
   int max_realignment_anchors = 64;
   // Until the first alignment, a frame with a usable marker location becomes a keyframe when
   // at least this many frames passed since the last keyframe.
-  int min_frames_between_anchor_keyframes = 2;
+  int min_frames_between_anchor_keyframes = 1;
   // Aligned map, tracking lost for this many frames in a row while markers give poses but
   // the map does not take them back: the map is discarded and a new one initialised and
   // aligned (the poses already output are kept).

@@ -149,6 +149,8 @@ void System::MaybeAlignWorld(Frame* frame) {
   anchors_ = std::move(live);
   if (static_cast<int>(anchors.size()) < needed ||
       Baseline(anchors) < options_.min_alignment_baseline_m) {
+    ARUCOSLAM_LOG_DEBUG("world alignment waits: {} anchors with keyframes ({} needed), baseline "
+                        "{:.2f} m", anchors.size(), needed, Baseline(anchors));
     return;
   }
   const WorldAlignment alignment = EstimateWorldFromMap(anchors, options_.alignment);
