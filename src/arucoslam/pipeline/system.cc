@@ -15,7 +15,7 @@ bool SystemOptions::Check() const {
          locator.Check() && alignment.Check() && max_marker_rms_px > 0.0 &&
          max_marker_distance_sides > 0.0 &&
          min_alignment_anchors >= 2 && min_alignment_baseline_m >= 0.0 &&
-         max_alignment_rms_m > 0.0 && marker_reset_lost_frames >= 1 &&
+         max_alignment_rms_m > 0.0 && max_alignment_scale > 0.0 && marker_reset_lost_frames >= 1 &&
          max_realignment_anchors >= min_alignment_anchors && places.Check() &&
          max_marker_disagreement_m > 0.0 && min_frames_between_anchor_keyframes >= 0 &&
          marker_mapping.Check() && new_map_after_lost_s > 0.0 &&

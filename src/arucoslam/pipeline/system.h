@@ -77,6 +77,11 @@ struct SystemOptions {
   int min_alignment_anchors = 4;
   double min_alignment_baseline_m = 0.5;
   double max_alignment_rms_m = 0.15;
+  // A map starts with its median point depth 1: aligning it multiplies lengths by about the
+  // scene's depth in metres. A first alignment's scale above this means the map collapsed
+  // in scale before it saw markers (measured: 1256 for a map born in a bland U-turn, whose
+  // early poses then lay up to 224 m off); it is refused.
+  double max_alignment_scale = 100.0;
   // After the first alignment, anchors keep being collected and the map is aligned again
   // (a small Sim3 correction) each time their number doubles, up to this many anchors.
   int max_realignment_anchors = 64;

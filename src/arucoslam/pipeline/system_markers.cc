@@ -154,9 +154,11 @@ void System::MaybeAlignWorld(Frame* frame) {
     return;
   }
   const WorldAlignment alignment = EstimateWorldFromMap(anchors, options_.alignment);
-  if (!alignment.success || alignment.rms_m > options_.max_alignment_rms_m) {
-    ARUCOSLAM_LOG_DEBUG("world alignment refused ({} anchors): {} rms {:.3f} m", anchors.size(),
-                        alignment.failure, alignment.rms_m);
+  if (!alignment.success || alignment.rms_m > options_.max_alignment_rms_m ||
+      (!world_aligned_ && alignment.world_from_map.scale > options_.max_alignment_scale)) {
+    ARUCOSLAM_LOG_DEBUG("world alignment refused ({} anchors): {} rms {:.3f} m, scale {:.2f}",
+                        anchors.size(), alignment.failure, alignment.rms_m,
+                        alignment.world_from_map.scale);
     return;
   }
   const Sim3& world_from_map = alignment.world_from_map;
