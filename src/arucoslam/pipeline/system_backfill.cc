@@ -23,7 +23,9 @@ void System::BackfillInitialization(const Frame& second, KeyframeId first_id,
   std::vector<Frame> frames = std::move(initialisation_frames_);
   initialisation_frames_.clear();
   if (frames.empty()) return;
-  Tracker backwards(*map_, options_.tracker);
+  TrackerOptions tracking = options_.tracker;
+  tracking.update_point_statistics = false;  // the map stays exactly as without the backfill
+  Tracker backwards(*map_, tracking);
   backwards.Start(second, second_id);
   std::vector<TrackedPose> found;
   for (auto it = frames.rbegin(); it != frames.rend(); ++it) {

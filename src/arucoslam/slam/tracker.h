@@ -61,6 +61,9 @@ struct TrackerOptions {
   // TrackFromPose: the keyframe nearest the given pose whose optical axis is within this
   // angle's cosine of the camera's (about 60 degrees) gives the points to project.
   double relocalization_min_axis_cos = 0.5;
+  // Count each local-map search in the points' visible/found statistics (point culling
+  // reads them). False for tracking that must leave the map untouched (initialisation backfill).
+  bool update_point_statistics = true;
 
   bool Check() const;
 };

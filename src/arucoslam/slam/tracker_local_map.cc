@@ -108,12 +108,14 @@ bool Tracker::TrackLocalMap(Frame& frame, TrackingResult& result, double radius_
       MatchByProjection(frame.features, grid, set.queries, taken, options_.local_map_search);
   result.num_local_map_matches = set.AssignTo(matches, frame);
   result.num_inliers = OptimizeFramePose(frame, *frame.cam_from_world);
-  map_.Write([&](MapData& data) {
-    for (const MapPointId& id : visible) data.IncreaseVisible(id);
-    for (const MapPointId& id : frame.map_point_ids) {
-      if (id.IsValid()) data.IncreaseFound(id);
-    }
-  });
+  if (options_.update_point_statistics) {
+    map_.Write([&](MapData& data) {
+      for (const MapPointId& id : visible) data.IncreaseVisible(id);
+      for (const MapPointId& id : frame.map_point_ids) {
+        if (id.IsValid()) data.IncreaseFound(id);
+      }
+    });
+  }
   if (result.num_inliers >= options_.min_local_map_inliers) return true;
   return allow_weak && result.num_inliers >= options_.min_weak_inliers && frame.cam_from_world &&
          AgreesWithPrediction(*frame.cam_from_world, frames_lost_ + 1);
