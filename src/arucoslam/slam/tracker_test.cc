@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <utility>
+
 #include <algorithm>
 #include <random>
 
@@ -200,6 +202,34 @@ TEST(TrackerTest, TracksASequenceToTheTruth) {
   const double found_ratio =
       map.Read([](const MapData& data) { return data.map_points().begin()->second.FoundRatio(); });
   EXPECT_GT(found_ratio, 0.5);
+}
+
+// A tracker with update_point_statistics off (the initialisation backfill's) tracks as well
+// and leaves every point's visible/found counts as they were.
+TEST(TrackerTest, TrackingWithoutPointStatisticsLeavesTheMapUntouched) {
+  SyntheticWorld world(2);
+  Map map;
+  Frame start;
+  const KeyframeId reference = BuildInitialMap(world, map, &start);
+  const auto counts = [&] {
+    return map.Read([](const MapData& data) {
+      std::vector<std::pair<int, int>> all;
+      for (const auto& [id, point] : data.map_points()) all.emplace_back(point.num_visible, point.num_found);
+      return all;
+    });
+  };
+  const auto before = counts();
+  TrackerOptions options;
+  options.update_point_statistics = false;
+  Tracker tracker(map, options);
+  tracker.Start(start, reference);
+  std::vector<int> truth;
+  for (int t = 6; t <= 12; ++t) {
+    Frame frame = world.MakeFrame(t, &truth);
+    ASSERT_EQ(tracker.Track(frame).state, TrackingState::kTracking) << "frame " << t;
+    EXPECT_LT(PositionError(*frame.cam_from_world, world.CamFromWorld(t)), 0.005) << t;
+  }
+  EXPECT_EQ(counts(), before);
 }
 
 // One unrelated frame (a bland view) loses tracking; with recovery_frames the motion model
