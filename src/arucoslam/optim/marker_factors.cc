@@ -88,6 +88,21 @@ int ApplyMarkerFactors(const MarkerFactors& factors, MarkerLandmarks* landmarks)
   return moved;
 }
 
+Matrix6d MarkerPriorInformation(const MarkerFactorOptions& options, double nearest_marker_sides,
+                                double num_markers) {
+  double growth = 1.0;  // variance factor for the distance
+  if (options.prior_reference_distance_sides > 0.0) {
+    const double ratio = nearest_marker_sides / options.prior_reference_distance_sides;
+    growth = std::max(1.0, ratio * ratio * ratio * ratio);
+  }
+  Matrix6d information = Matrix6d::Zero();
+  information.diagonal() << Eigen::Vector3d::Constant(
+      num_markers / (growth * options.prior_position_sigma_m * options.prior_position_sigma_m)),
+      Eigen::Vector3d::Constant(num_markers / (growth * options.prior_rotation_sigma_rad *
+                                               options.prior_rotation_sigma_rad));
+  return information;
+}
+
 std::vector<PoseGraphProblem::PosePrior> MarkerPosePriors(const MapData& data,
                                                           const std::vector<KeyframeId>& keyframe_ids,
                                                           const MarkerLandmarks& landmarks,
@@ -149,22 +164,10 @@ std::vector<PoseGraphProblem::PosePrior> MarkerPosePriors(const MapData& data,
     if (options.max_prior_distance_sides > 0.0 && nearest_sides > options.max_prior_distance_sides) {
       continue;
     }
-    double growth = 1.0;  // variance factor for the distance
-    if (options.prior_reference_distance_sides > 0.0) {
-      const double ratio = nearest_sides / options.prior_reference_distance_sides;
-      growth = std::max(1.0, ratio * ratio * ratio * ratio);
-    }
-    const double count = result.num_marker_inliers;
-    const double position_information =
-        count / (growth * options.prior_position_sigma_m * options.prior_position_sigma_m);
-    const double rotation_information =
-        count / (growth * options.prior_rotation_sigma_rad * options.prior_rotation_sigma_rad);
     PoseGraphProblem::PosePrior prior;
     prior.node = node;
     prior.world_from_cam = result.cam_from_world.Inverse();
-    prior.information.setZero();
-    prior.information.diagonal() << Eigen::Vector3d::Constant(position_information),
-        Eigen::Vector3d::Constant(rotation_information);
+    prior.information = MarkerPriorInformation(options, nearest_sides, result.num_marker_inliers);
     priors.push_back(prior);
   }
   return priors;

@@ -68,6 +68,12 @@ BundleAdjustmentSummary SolveBundleAdjustmentWithMarkers(const BundleAdjustmentO
 // Writes the solved poses of non-fixed markers back into `landmarks`; returns how many.
 int ApplyMarkerFactors(const MarkerFactors& factors, MarkerLandmarks* landmarks);
 
+// Information of a marker pose prior over [centre, metres; rotation, radians]: `num_markers`
+// markers seen from `nearest_marker_sides` marker sides (the options' sigmas, grown with
+// distance as prior_reference_distance_sides says).
+Matrix6d MarkerPriorInformation(const MarkerFactorOptions& options, double nearest_marker_sides,
+                                double num_markers);
+
 // Absolute pose priors for a pose graph (node i is keyframe_ids[i]): for each keyframe that
 // sees at least min_prior_markers fixed markers, its pose from those markers' corners alone
 // (refined from the keyframe's current pose), when the corners fit within the chi-square test.

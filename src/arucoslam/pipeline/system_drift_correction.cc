@@ -12,21 +12,12 @@
 namespace arucoslam {
 
 KeyframePosePrior System::MarkerPrior(KeyframeId keyframe, const MarkerFix& fix) const {
-  const MarkerFactorOptions& options = options_.marker_priors;
-  double growth = 1.0;  // variance factor for the distance
-  if (options.prior_reference_distance_sides > 0.0) {
-    const double ratio = fix.nearest_marker_sides / options.prior_reference_distance_sides;
-    growth = std::max(1.0, ratio * ratio * ratio * ratio);
-  }
-  const double count = std::max<std::size_t>(1, fix.markers.size());
   KeyframePosePrior prior;
   prior.keyframe = keyframe;
   prior.world_from_cam = fix.world_from_cam;
-  prior.information.setZero();
-  prior.information.diagonal() << Eigen::Vector3d::Constant(
-      count / (growth * options.prior_position_sigma_m * options.prior_position_sigma_m)),
-      Eigen::Vector3d::Constant(
-          count / (growth * options.prior_rotation_sigma_rad * options.prior_rotation_sigma_rad));
+  prior.information = MarkerPriorInformation(
+      options_.marker_priors, fix.nearest_marker_sides,
+      static_cast<double>(std::max<std::size_t>(1, fix.markers.size())));
   return prior;
 }
 
