@@ -3,12 +3,15 @@
 #include <fmt/format.h>
 
 #include <cstdio>
+#include <memory>
 #include <optional>
 
+#include "arucoslam/exe/default_vocabulary.h"
 #include "arucoslam/exe/experiments_report.h"
 #include "arucoslam/exe/marker_only_run.h"
 #include "arucoslam/exe/slam_run.h"
 #include "arucoslam/eval/world_surfaces.h"
+#include "arucoslam/feature/vocabulary.h"
 #include "arucoslam/io/dataset_reader.h"
 #include "arucoslam/io/marker_map_json.h"
 #include "arucoslam/io/path_json.h"
@@ -107,16 +110,26 @@ ExperimentRun MarkerOnlyRun(const fs::path& sequence, const fs::path& out_dir, b
   return run;
 }
 
-// ArucoSLAM (blocking, deterministic): keypoints and the sequence's known markers.
-ExperimentRun MarkerSlamRun(const fs::path& sequence, const fs::path& out_dir, bool progress) {
+// The SLAM of every run: blocking (deterministic), with the place database and loop closing
+// as `arucoslam run` has them by default.
+SystemOptions SlamOptions(const std::shared_ptr<const Vocabulary>& vocabulary, bool loop_closing) {
+  SystemOptions options;
+  options.blocking = true;
+  options.vocabulary = vocabulary;
+  options.places.loop_closing = loop_closing;
+  return options;
+}
+
+// ArucoSLAM: keypoints and the sequence's known markers.
+ExperimentRun MarkerSlamRun(const fs::path& sequence, const fs::path& out_dir,
+                            const SystemOptions& slam, bool progress) {
   ExperimentRun run;
   run.label = "1: ArucoSLAM (markers + keypoints)";
   run.sequence = "with markers";
   const Dataset dataset = Dataset::Open(sequence);
   const std::optional<MarkerMap> markers = SequenceMarkerMap(dataset, run);
   if (!markers) return run;
-  SystemOptions options;
-  options.blocking = true;
+  SystemOptions options = slam;
   options.marker_map = *markers;
   options.detector.dictionary = options.marker_map->dictionary;
   if (progress) std::fprintf(stderr, "SLAM, %s\n", run.label.c_str());
@@ -138,15 +151,15 @@ ExperimentRun MarkerSlamRun(const fs::path& sequence, const fs::path& out_dir, b
   return run;
 }
 
-// Keypoint-only SLAM (blocking, deterministic) on one rendered sequence.
+// Keypoint-only SLAM on one rendered sequence.
 ExperimentRun KeypointSlamRun(const std::string& label, const std::string& sequence_name,
-                              const fs::path& sequence, const fs::path& out_dir, bool progress) {
+                              const fs::path& sequence, const fs::path& out_dir,
+                              const SystemOptions& slam, bool progress) {
   ExperimentRun run;
   run.label = label;
   run.sequence = sequence_name;
   const Dataset dataset = Dataset::Open(sequence);
-  SystemOptions options;
-  options.blocking = true;
+  const SystemOptions& options = slam;
   if (progress) std::fprintf(stderr, "SLAM, %s\n", label.c_str());
   const SlamRunResult result =
       RunSlamOnDataset(dataset, sequence.string(), options, /*markers=*/false, out_dir, progress);
@@ -169,6 +182,10 @@ ExperimentsResult RunExperiments(const ExperimentsOptions& options) {
   if (!options.Check()) throw InputError("experiments", "invalid options");
   RequireDirectory(options.world_dir, "world folder");
   const std::vector<TimedPose> poses = RepeatRunPoses(options.world_dir, options.max_seconds);
+  // Loaded before anything is rendered: a bad vocabulary fails fast.
+  const std::shared_ptr<const Vocabulary> vocabulary = std::make_shared<const Vocabulary>(
+      Vocabulary::Load(options.vocabulary.empty() ? DefaultVocabularyPath() : options.vocabulary));
+  const SystemOptions slam = SlamOptions(vocabulary, options.loop_closing);
 
   StagedDirectory staged(options.out_dir);
   const fs::path with_markers =
@@ -181,15 +198,15 @@ ExperimentsResult RunExperiments(const ExperimentsOptions& options) {
 
   ExperimentsResult result;
   result.runs.push_back(
-      MarkerSlamRun(with_markers, staged.path() / "run1_arucoslam", options.progress));
+      MarkerSlamRun(with_markers, staged.path() / "run1_arucoslam", slam, options.progress));
   result.runs.push_back(KeypointSlamRun("2: keypoints only, markers in scene", "with markers",
                                         with_markers, staged.path() / "run2_keypoints_with_markers",
-                                        options.progress));
+                                        slam, options.progress));
   if (without_markers) {
     result.runs.push_back(KeypointSlamRun("3: keypoints only, no markers", "without markers",
                                           *without_markers,
                                           staged.path() / "run3_keypoints_without_markers",
-                                          options.progress));
+                                          slam, options.progress));
   } else {
     ExperimentRun run;
     run.label = "3: keypoints only, no markers";

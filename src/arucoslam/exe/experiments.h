@@ -23,6 +23,10 @@ struct ExperimentsOptions {
   double max_seconds = 0.0;  // render only the first seconds of the route (0: all)
   DatasetWriterOptions render = DefaultSensorOptions();  // the sensor of `simulate`
   bool progress = true;
+  // Bag-of-words vocabulary of the SLAM runs (relocalisation and loop closing, as `run`);
+  // empty: the one shipped with arucoslam. `loop_closing` false: relocalisation only.
+  std::filesystem::path vocabulary;
+  bool loop_closing = true;
 
   bool Check() const { return max_seconds >= 0.0 && render.Check(); }
 };

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "arucoslam/exe/command.h"
+#include "arucoslam/exe/default_vocabulary.h"
 #include "arucoslam/exe/experiments.h"
 #include "arucoslam/sim/factory_world.h"
 #include "arucoslam/util/error.h"
@@ -51,7 +52,14 @@ void AddExperimentsCommand(CLI::App& app, int& exit_status) {
   command->add_option("--max-seconds", options->max_seconds,
                       "use only the first seconds of the route (0: all)")
       ->capture_default_str();
-  command->callback([options, without, &exit_status] {
+  command->add_option("--vocabulary", options->vocabulary,
+                      "bag-of-words vocabulary of the SLAM runs (default: " +
+                          std::string(kDefaultVocabularyName) + " shipped with arucoslam)");
+  auto no_loop_closing = std::make_shared<bool>(false);
+  command->add_flag("--no-loop-closing", *no_loop_closing,
+                    "the SLAM runs do not close loops (relocalisation stays on)");
+  command->callback([options, without, no_loop_closing, &exit_status] {
+    options->loop_closing = !*no_loop_closing;
     if (!without->empty()) options->world_without_markers_dir = *without;
     PrintResult(RunExperiments(*options), options->out_dir);
     exit_status = kExitOk;

@@ -94,5 +94,17 @@ TEST_F(ExperimentsCommandTest, MissingWorldIsOneLineAndExitTwo) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+TEST_F(ExperimentsCommandTest, MissingVocabularyIsOneLineAndExitTwoBeforeAnythingIsRendered) {
+  const fs::path world = dir_ / "world";
+  ASSERT_EQ(RunArucoslam("world factory --out " + world.string()).status, 0);
+  const fs::path out = dir_ / "exp";
+  const auto result = RunArucoslam("experiments --world " + world.string() + " --vocabulary " +
+                                   (dir_ / "none.bin").string() + " --out " + out.string());
+  EXPECT_EQ(result.status, 2) << result.output;
+  EXPECT_NE(result.output.find("none.bin"), std::string::npos) << result.output;
+  EXPECT_EQ(std::count(result.output.begin(), result.output.end(), '\n'), 1) << result.output;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 }  // namespace
 }  // namespace arucoslam
