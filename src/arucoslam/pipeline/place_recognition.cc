@@ -167,9 +167,9 @@ void PlaceRecognition::DetectAndClose(KeyframeId keyframe) {
     }
     const double correction_ms = correction.ElapsedMilliseconds();
     if (!result.closed) {
-      ARUCOSLAM_LOG_INFO("loop {} -> {} rejected: {} ({} matches, {} Sim3 inliers)",
-                         keyframe.value, candidate.value, result.reason, result.num_matches,
-                         result.num_sim3_inliers);
+      ARUCOSLAM_LOG_DEBUG("loop {} -> {} rejected: {} ({} matches, {} Sim3 inliers)",
+                          keyframe.value, candidate.value, result.reason, result.num_matches,
+                          result.num_sim3_inliers);
       std::lock_guard lock(*stats_mutex_);
       ++stats_->num_loop_candidates;
       ++stats_->num_loops_rejected;
