@@ -135,8 +135,10 @@ AmbiguityChoice System::ResolveByMotion(const CameraLocation& location,
   // fixes predict independently; when both settle the ambiguity they must agree.
   if (!location.alternative_world_from_cam) return AmbiguityChoice::kNone;
   AmbiguityChoice by_tracker = AmbiguityChoice::kNone;
+  bool tracker_prediction = false, fixes_prediction = false;
   if (world_aligned_) {
     if (const std::optional<Rigid3> predicted = tracker_->PredictedPose()) {
+      tracker_prediction = true;
       by_tracker = ResolveAmbiguity(location, predicted->Inverse(), options_.ambiguity_gates);
       ARUCOSLAM_LOG_DEBUG("t {:.3f}: ambiguous marker vs tracker prediction: {}", timestamp_s,
                           DistancesFrom(location, predicted->Inverse()));
@@ -144,9 +146,13 @@ AmbiguityChoice System::ResolveByMotion(const CameraLocation& location,
   }
   AmbiguityChoice by_fixes = AmbiguityChoice::kNone;
   if (const std::optional<Rigid3> predicted = fix_motion_.Predict(timestamp_s)) {
+    fixes_prediction = true;
     by_fixes = ResolveAmbiguity(location, *predicted, options_.ambiguity_gates);
     ARUCOSLAM_LOG_DEBUG("t {:.3f}: ambiguous marker vs marker-fix prediction: {}", timestamp_s,
                         DistancesFrom(location, *predicted));
+  }
+  if (!tracker_prediction && !fixes_prediction) {
+    ARUCOSLAM_LOG_DEBUG("t {:.3f}: ambiguous marker, no motion prediction", timestamp_s);
   }
   if (by_tracker == AmbiguityChoice::kNone) return by_fixes;
   if (by_fixes != AmbiguityChoice::kNone && by_fixes != by_tracker) return AmbiguityChoice::kNone;
