@@ -43,6 +43,9 @@ SlamRunStats MakeStats(const std::string& dataset_label, const Dataset& dataset,
   out.keyframes_inserted = stats.num_keyframes_inserted;
   out.keyframes = static_cast<int>(system.map().NumKeyframes());
   out.map_points = static_cast<int>(system.map().NumMapPoints());
+  out.marker_fix_frames = stats.num_marker_frames;
+  out.marker_disambiguations = stats.num_marker_disambiguations;
+  out.marker_only_poses = stats.num_marker_only_poses;
   out.wall_time_s = wall_time_s;
   out.peak_memory_bytes = PeakMemoryBytes();
   out.timings_ms = {{"extraction", stats.extraction_ms.Summarize()},

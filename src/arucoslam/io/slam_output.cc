@@ -43,6 +43,11 @@ std::string FormatSlamStatsJson(const SlamRunStats& stats) {
                  {"points", stats.map_points},
                  {"loops_closed", stats.loops_closed},
                  {"global_bundle_adjustments", stats.global_bundle_adjustments}};
+  if (stats.markers) {
+    json["marker_locations"] = {{"frames_with_fix", stats.marker_fix_frames},
+                                {"disambiguated_by_motion", stats.marker_disambiguations},
+                                {"marker_only_poses", stats.marker_only_poses}};
+  }
   nlohmann::ordered_json timings = nlohmann::ordered_json::object();
   for (const auto& [stage, summary] : stats.timings_ms) {
     timings[stage] = {{"count", summary.count},

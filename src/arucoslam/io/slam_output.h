@@ -34,6 +34,11 @@ struct SlamRunStats {
   int keyframes_inserted = 0;
   int keyframes = 0;   // in the final map
   int map_points = 0;  // in the final map
+  // With a marker map: frames with a usable marker location, of which one ambiguous
+  // marker settled by the motion prediction, and frames whose pose came from markers alone.
+  int marker_fix_frames = 0;
+  int marker_disambiguations = 0;
+  int marker_only_poses = 0;
   double wall_time_s = 0.0;
   std::size_t peak_memory_bytes = 0;
   // Per-stage timings in milliseconds, e.g. {"tracking", summary}.
@@ -44,7 +49,8 @@ struct SlamRunStats {
 std::string FormatPlyPoints(const std::vector<Eigen::Vector3d>& points);
 // stats.json text: {"format": "arucoslam.stats/1", "dataset", "frames": {...},
 // "tracking": {"losses", "relocalisations", ...}, "map": {..., "loops_closed",
-// "global_bundle_adjustments"}, "timings_ms": {stage:
+// "global_bundle_adjustments"}, with markers "marker_locations": {"frames_with_fix",
+// "disambiguated_by_motion", "marker_only_poses"}, "timings_ms": {stage:
 // {count, mean, median, p95, max}}, "wall_time_s", "peak_memory_bytes"}.
 std::string FormatSlamStatsJson(const SlamRunStats& stats);
 

@@ -144,9 +144,14 @@ std::pair<Rigid3, Score> SelectAndRefine(const Correspondences& c, const CameraM
   return {best, best_score};
 }
 
-// One marker used: its IPPE ambiguity, and the other IPPE solution as the alternative.
+// One marker used: its IPPE ambiguity, and the other IPPE solution as the alternative,
+// refined by LM when the refinement stays in that solution's basin (away from the best).
 void FillSingleMarkerAmbiguity(const std::vector<MarkerPose>& marker_poses, const MarkerMap& map,
-                               CameraLocation& result) {
+                               const Correspondences& c, const CameraModel& camera,
+                               const CameraLocatorOptions& options, CameraLocation& result) {
+  const auto distance = [&result](const Rigid3& x) {
+    return RotationAngle(x.rotation.inverse() * result.world_from_cam.rotation);
+  };
   for (const MarkerPose& pose : marker_poses) {
     if (pose.id != result.marker_ids.front()) continue;
     result.quality.ambiguous = pose.ambiguous;
@@ -155,11 +160,36 @@ void FillSingleMarkerAmbiguity(const std::vector<MarkerPose>& marker_poses, cons
     const MarkerInfo* info = map.Find(pose.id);
     const Rigid3 a = info->world_from_marker * pose.solutions[0].cam_from_marker.Inverse();
     const Rigid3 b = info->world_from_marker * pose.solutions[1].cam_from_marker.Inverse();
-    const auto distance = [&result](const Rigid3& x) {
-      return RotationAngle(x.rotation.inverse() * result.world_from_cam.rotation);
-    };
-    result.alternative_world_from_cam = distance(a) > distance(b) ? a : b;
+    const Rigid3 alternative = distance(a) > distance(b) ? a : b;
+    const double threshold = options.inlier_threshold_px;
+    const Rigid3 refined =
+        Refine(c, camera, alternative, threshold, options.refine_max_iterations);
+    const Score before = ScorePose(c, camera, alternative, threshold);
+    const Score after = ScorePose(c, camera, refined, threshold);
+    const bool keeps_basin = distance(refined) > 0.5 * distance(alternative);
+    result.alternative_world_from_cam =
+        keeps_basin && after.inliers >= before.inliers && after.cost <= before.cost
+            ? refined
+            : alternative;
+    const std::vector<double> errors = PixelErrors(c, camera, *result.alternative_world_from_cam);
+    double sum = 0.0;
+    int count = 0;
+    for (size_t i = 0; i < errors.size(); ++i) {
+      if (c.marker_ids[i] != pose.id) continue;
+      sum += errors[i] * errors[i];
+      ++count;
+    }
+    result.quality.alternative_rms_px = std::sqrt(sum / count);
   }
+}
+
+// Distance of `pose` from `predicted` in units of its gate (the larger of rotation and
+// position).
+double GateUnits(const Rigid3& pose, const Rigid3& predicted, const AmbiguityPriorGates& gates) {
+  const double rotation_deg =
+      RotationAngle(pose.rotation.inverse() * predicted.rotation) * 180.0 / M_PI;
+  const double position_m = (pose.translation - predicted.translation).norm();
+  return std::max(rotation_deg / gates.max_rotation_deg, position_m / gates.max_position_m);
 }
 
 }  // namespace
@@ -211,8 +241,34 @@ CameraLocation LocateCamera(const std::vector<MarkerDetection>& detections, cons
   result.quality.num_inlier_corners = score.inliers;
   result.quality.num_markers = static_cast<int>(used.size());
   result.quality.reprojection_rms_px = std::sqrt(sum / score.inliers);
-  if (used.size() == 1) FillSingleMarkerAmbiguity(marker_poses, map, result);
+  if (used.size() == 1) FillSingleMarkerAmbiguity(marker_poses, map, c, camera, options, result);
   return result;
+}
+
+AmbiguityChoice ResolveAmbiguity(const CameraLocation& location,
+                                 const Rigid3& predicted_world_from_cam,
+                                 const AmbiguityPriorGates& gates) {
+  if (!location.found || !location.alternative_world_from_cam || !gates.Check()) {
+    return AmbiguityChoice::kNone;
+  }
+  const double best = GateUnits(location.world_from_cam, predicted_world_from_cam, gates);
+  const double other =
+      GateUnits(*location.alternative_world_from_cam, predicted_world_from_cam, gates);
+  if (best <= 1.0 && other >= gates.min_disagreement) return AmbiguityChoice::kBest;
+  if (other <= 1.0 && best >= gates.min_disagreement) return AmbiguityChoice::kAlternative;
+  return AmbiguityChoice::kNone;
+}
+
+std::optional<Rigid3> ChosenPose(const CameraLocation& location, AmbiguityChoice choice) {
+  switch (choice) {
+    case AmbiguityChoice::kBest:
+      return location.world_from_cam;
+    case AmbiguityChoice::kAlternative:
+      return location.alternative_world_from_cam;
+    case AmbiguityChoice::kNone:
+      break;
+  }
+  return std::nullopt;
 }
 
 }  // namespace arucoslam

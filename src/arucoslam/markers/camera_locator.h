@@ -34,6 +34,7 @@ struct LocateQuality {
   // alternative pose below then explains the image almost as well.
   bool ambiguous = false;
   double error_ratio = 0.0;  // one marker: IPPE best / second error; several: 0
+  double alternative_rms_px = 0.0;  // one marker: corner RMS of the alternative, pixels
 };
 
 struct CameraLocation {
@@ -46,9 +47,34 @@ struct CameraLocation {
   std::vector<int> unknown_marker_ids;  // detected but absent from the map
 };
 
+// How a pose predicted from the camera's motion settles a one-marker ambiguity
+// (ResolveAmbiguity): a solution is taken when it lies within both gates of the prediction
+// while the other lies beyond min_disagreement times a gate (rotation or position).
+struct AmbiguityPriorGates {
+  double max_rotation_deg = 4.0;
+  double max_position_m = 0.2;
+  double min_disagreement = 2.0;  // > 1
+
+  bool Check() const {
+    return max_rotation_deg > 0.0 && max_position_m > 0.0 && min_disagreement > 1.0;
+  }
+};
+
 // Never throws for expected failures (no known marker, too few inliers): `found` is false
 // and `failure` says why. Marker sizes come from the map.
 CameraLocation LocateCamera(const std::vector<MarkerDetection>& detections, const MarkerMap& map,
                             const CameraModel& camera, const CameraLocatorOptions& options = {});
+
+// Which solution of an ambiguous one-marker location a prediction settles on.
+enum class AmbiguityChoice { kNone, kBest, kAlternative };
+
+// Of an ambiguous one-marker location (alternative_world_from_cam set), the solution that
+// agrees with `predicted_world_from_cam` while the other clearly does not; kNone when
+// neither or both agree, or the location has no alternative.
+AmbiguityChoice ResolveAmbiguity(const CameraLocation& location,
+                                 const Rigid3& predicted_world_from_cam,
+                                 const AmbiguityPriorGates& gates = {});
+// The pose of `choice` (kNone: nullopt).
+std::optional<Rigid3> ChosenPose(const CameraLocation& location, AmbiguityChoice choice);
 
 }  // namespace arucoslam

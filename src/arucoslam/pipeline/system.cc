@@ -13,7 +13,7 @@ bool SystemOptions::Check() const {
          keyframes.Check() && mapper.Check() && mapper_queue_capacity >= 1 &&
          max_initialization_gap_s > 0.0 && reset_max_keyframes >= 0 && detector.Check() &&
          locator.Check() && alignment.Check() && max_marker_rms_px > 0.0 &&
-         max_marker_distance_sides > 0.0 &&
+         max_marker_distance_sides > 0.0 && ambiguity_gates.Check() && fix_motion.Check() &&
          min_alignment_anchors >= 2 && min_alignment_baseline_m >= 0.0 &&
          max_alignment_rms_m > 0.0 && max_alignment_scale > 0.0 && marker_reset_lost_frames >= 1 &&
          max_realignment_anchors >= min_alignment_anchors && places.Check() &&

@@ -24,6 +24,7 @@
 #include "arucoslam/markers/marker_map.h"
 #include "arucoslam/pipeline/bounded_queue.h"
 #include "arucoslam/pipeline/place_recognition.h"
+#include "arucoslam/pipeline/world_motion_prior.h"
 #include "arucoslam/slam/initializer.h"
 #include "arucoslam/slam/keyframe_policy.h"
 #include "arucoslam/slam/local_mapper.h"
@@ -71,6 +72,12 @@ struct SystemOptions {
   // location's error grows with the square of the distance (default factory, 0.2 m markers:
   // 1-2 cm at 2.5-4.5 m, 5-15 cm at 5-6 m with two markers, decimetres beyond).
   double max_marker_distance_sides = 25.0;
+  // An ambiguous one-marker location is still used when a prediction of the frame's world
+  // pose (the aligned tracker's motion model, else constant velocity from the recent marker
+  // fixes) settles it: system_markers.cc, ResolveAmbiguity.
+  bool resolve_ambiguity_by_motion = true;
+  AmbiguityPriorGates ambiguity_gates;
+  WorldMotionPriorOptions fix_motion;
   // World alignment waits for this many keyframes with a usable marker location whose
   // camera centres span at least min_alignment_baseline_m (metres); it is refused when the
   // anchors' residual after alignment exceeds max_alignment_rms_m (metres).
@@ -187,6 +194,7 @@ struct SystemStats {
   int num_keyframes_inserted = 0;
   TimingStats marker_ms;          // per frame with a marker map: detection and location
   int num_marker_frames = 0;      // frames with a usable marker location
+  int num_marker_disambiguations = 0;  // ... of which one ambiguous marker settled by motion
   int num_marker_only_poses = 0;  // frames whose pose came from markers alone
   int num_world_alignments = 0;
   int num_marker_relocalizations = 0;  // tracking restarted from a marker pose
@@ -263,6 +271,7 @@ class System {
     std::vector<MarkerPoseObservation> markers;  // its inlier markers, undistorted corners
     double nearest_marker_sides = 0.0;           // camera to its nearest marker, in sides
     bool known_markers_only = true;  // located by markers.json's fixed markers alone
+    bool disambiguated_by_motion = false;  // one ambiguous marker, settled by the prediction
   };
 
   void Initialize(Frame& frame, FrameReport& report);
@@ -272,6 +281,8 @@ class System {
                                              const std::vector<MarkerDetection>& detections,
                                              FrameReport& report);
   bool RelocalizeWithMarkers(Frame& frame, FrameReport& report);
+  // The solution of an ambiguous one-marker location that the motion predictions settle on.
+  AmbiguityChoice ResolveByMotion(const CameraLocation& location, double timestamp_s) const;
   // True when the frame's marker location (world-aligned map) contradicts the pose.
   bool DisagreesWithMarkers(const Rigid3& cam_from_world) const;
   // Map reuse (system_map_reuse.cc): a frame before the first localisation in a loaded map,
@@ -367,6 +378,7 @@ class System {
   std::unique_ptr<MarkerDetector> detector_;  // with a marker map only
   std::optional<MarkerFix> fix_;               // the current frame's
   std::optional<MarkerFix> init_reference_fix_;
+  WorldMotionPrior fix_motion_{options_.fix_motion};  // the recent fixes' world poses
   std::vector<MarkerAnchor> anchors_;
   bool world_aligned_ = false;
   // Until the map is aligned, keyframes that saw a marker are not culled: they carry the

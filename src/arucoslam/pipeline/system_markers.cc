@@ -1,7 +1,11 @@
 // System's marker handling: locating each frame in the known marker map, marker-only poses,
 // relocalisation from a marker pose, and the Sim(3) alignment of the keypoint map to the world.
+#include <fmt/format.h>
+
 #include <algorithm>
+#include <cmath>
 #include <limits>
+#include <string>
 #include <utility>
 
 #include "arucoslam/pipeline/system.h"
@@ -27,16 +31,29 @@ double Baseline(const std::vector<WorldAnchor>& anchors) {
   return baseline;
 }
 
-// Distance from the camera to its nearest located marker, in that marker's sides.
-double NearestMarkerInSides(const CameraLocation& location, const MarkerMap& known) {
+// Distance from the camera at `world_from_cam` to its nearest located marker, in that
+// marker's sides.
+double NearestMarkerInSides(const CameraLocation& location, const Rigid3& world_from_cam,
+                            const MarkerMap& known) {
   double nearest = std::numeric_limits<double>::infinity();
   for (const int id : location.marker_ids) {
     const MarkerInfo* info = known.Find(id);
     const double distance =
-        (info->world_from_marker.translation - location.world_from_cam.translation).norm();
+        (info->world_from_marker.translation - world_from_cam.translation).norm();
     nearest = std::min(nearest, distance / info->size);
   }
   return nearest;
+}
+
+// For the logs: how far both solutions of an ambiguous location lie from a prediction.
+std::string DistancesFrom(const CameraLocation& location, const Rigid3& predicted) {
+  const auto describe = [&predicted](const Rigid3& pose) {
+    return fmt::format("{:.1f} deg {:.2f} m",
+                       RotationAngle(pose.rotation.inverse() * predicted.rotation) * 180.0 / M_PI,
+                       (pose.translation - predicted.translation).norm());
+  };
+  return "best " + describe(location.world_from_cam) + ", other " +
+         describe(*location.alternative_world_from_cam);
 }
 
 }  // namespace
@@ -54,13 +71,26 @@ std::optional<System::MarkerFix> System::LocateWithMarkers(
   const CameraLocation location = LocateCamera(detections, known, camera_, options_.locator);
   report.num_markers = static_cast<int>(location.marker_ids.size());
   std::optional<MarkerFix> fix;
-  const double nearest_sides =
-      location.found ? NearestMarkerInSides(location, known) : std::numeric_limits<double>::infinity();
-  if (location.found && !location.quality.ambiguous &&
-      location.quality.reprojection_rms_px <= options_.max_marker_rms_px &&
+  // An ambiguous location counts only as the solution the motion prediction settles on.
+  const AmbiguityChoice choice =
+      location.found && location.quality.ambiguous && options_.resolve_ambiguity_by_motion
+          ? ResolveByMotion(location, frame.timestamp_s)
+          : AmbiguityChoice::kNone;
+  const bool resolved = choice != AmbiguityChoice::kNone;
+  const bool alternative = choice == AmbiguityChoice::kAlternative;
+  const Rigid3 world_from_cam =
+      resolved ? *ChosenPose(location, choice) : location.world_from_cam;
+  const double rms_px = alternative ? location.quality.alternative_rms_px
+                                    : location.quality.reprojection_rms_px;
+  const double nearest_sides = location.found
+                                   ? NearestMarkerInSides(location, world_from_cam, known)
+                                   : std::numeric_limits<double>::infinity();
+  if (location.found && (!location.quality.ambiguous || resolved) &&
+      rms_px <= options_.max_marker_rms_px &&
       nearest_sides <= options_.max_marker_distance_sides) {
     fix.emplace();
-    fix->world_from_cam = location.world_from_cam;
+    fix->world_from_cam = world_from_cam;
+    fix->disambiguated_by_motion = resolved;
     fix->nearest_marker_sides = nearest_sides;
     fix->known_markers_only = std::all_of(
         location.marker_ids.begin(), location.marker_ids.end(),
@@ -86,8 +116,47 @@ std::optional<System::MarkerFix> System::LocateWithMarkers(
   std::lock_guard lock(stats_mutex_);
   stats_.marker_ms.Add(detection_ms_ + watch.ElapsedMilliseconds());
   detection_ms_ = 0.0;
-  if (fix) ++stats_.num_marker_frames;
+  if (fix) {
+    fix_motion_.Add(frame.timestamp_s, fix->world_from_cam);
+    ++stats_.num_marker_frames;
+    if (fix->disambiguated_by_motion) ++stats_.num_marker_disambiguations;
+    if (fix->disambiguated_by_motion) {
+      ARUCOSLAM_LOG_DEBUG("frame {}: ambiguous marker {} settled by the motion prediction{}",
+                          report.index, location.marker_ids.front(),
+                          alternative ? " (IPPE's second solution)" : "");
+    }
+  }
   return fix;
+}
+
+AmbiguityChoice System::ResolveByMotion(const CameraLocation& location,
+                                        double timestamp_s) const {
+  // The aligned map's motion model (keypoint poses in the world) and the recent marker
+  // fixes predict independently; when both settle the ambiguity they must agree.
+  if (!location.alternative_world_from_cam) return AmbiguityChoice::kNone;
+  AmbiguityChoice by_tracker = AmbiguityChoice::kNone;
+  bool tracker_prediction = false, fixes_prediction = false;
+  if (world_aligned_) {
+    if (const std::optional<Rigid3> predicted = tracker_->PredictedPose()) {
+      tracker_prediction = true;
+      by_tracker = ResolveAmbiguity(location, predicted->Inverse(), options_.ambiguity_gates);
+      ARUCOSLAM_LOG_DEBUG("t {:.3f}: ambiguous marker vs tracker prediction: {}", timestamp_s,
+                          DistancesFrom(location, predicted->Inverse()));
+    }
+  }
+  AmbiguityChoice by_fixes = AmbiguityChoice::kNone;
+  if (const std::optional<Rigid3> predicted = fix_motion_.Predict(timestamp_s)) {
+    fixes_prediction = true;
+    by_fixes = ResolveAmbiguity(location, *predicted, options_.ambiguity_gates);
+    ARUCOSLAM_LOG_DEBUG("t {:.3f}: ambiguous marker vs marker-fix prediction: {}", timestamp_s,
+                        DistancesFrom(location, *predicted));
+  }
+  if (!tracker_prediction && !fixes_prediction) {
+    ARUCOSLAM_LOG_DEBUG("t {:.3f}: ambiguous marker, no motion prediction", timestamp_s);
+  }
+  if (by_tracker == AmbiguityChoice::kNone) return by_fixes;
+  if (by_fixes != AmbiguityChoice::kNone && by_fixes != by_tracker) return AmbiguityChoice::kNone;
+  return by_tracker;
 }
 
 void System::GuardMarkerKeyframes() {

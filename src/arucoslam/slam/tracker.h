@@ -111,6 +111,15 @@ class Tracker {
   KeyframeId reference_keyframe() const { return reference_keyframe_; }
   // cam_from_world(current) * world_from_cam(last) after the last successful frame.
   const std::optional<Rigid3>& velocity() const { return velocity_; }
+  // The motion model's prediction of the next frame's pose (cam_from_world, the map's
+  // frame), as Track would use it; nullopt without a last tracked pose and a velocity.
+  std::optional<Rigid3> PredictedPose() const {
+    if (state_ == TrackingState::kNotInitialized || !last_frame_ ||
+        !last_frame_->cam_from_world || !velocity_) {
+      return std::nullopt;
+    }
+    return Predict(frames_lost_ + 1);
+  }
 
  private:
   // `steps`: frames since the last tracked one (1 while tracking).
