@@ -110,16 +110,6 @@ ExperimentRun MarkerOnlyRun(const fs::path& sequence, const fs::path& out_dir, b
   return run;
 }
 
-// The SLAM of every run: blocking (deterministic), with the place database and loop closing
-// as `arucoslam run` has them by default.
-SystemOptions SlamOptions(const std::shared_ptr<const Vocabulary>& vocabulary, bool loop_closing) {
-  SystemOptions options;
-  options.blocking = true;
-  options.vocabulary = vocabulary;
-  options.places.loop_closing = loop_closing;
-  return options;
-}
-
 // ArucoSLAM: keypoints and the sequence's known markers.
 ExperimentRun MarkerSlamRun(const fs::path& sequence, const fs::path& out_dir,
                             const SystemOptions& slam, bool progress) {
@@ -185,7 +175,8 @@ ExperimentsResult RunExperiments(const ExperimentsOptions& options) {
   // Loaded before anything is rendered: a bad vocabulary fails fast.
   const std::shared_ptr<const Vocabulary> vocabulary = std::make_shared<const Vocabulary>(
       Vocabulary::Load(options.vocabulary.empty() ? DefaultVocabularyPath() : options.vocabulary));
-  const SystemOptions slam = SlamOptions(vocabulary, options.loop_closing);
+  // Every run is blocking (deterministic) and otherwise the SLAM `arucoslam run` runs.
+  const SystemOptions slam = DefaultRunOptions(/*blocking=*/true, vocabulary, options.loop_closing);
 
   StagedDirectory staged(options.out_dir);
   const fs::path with_markers =

@@ -71,12 +71,12 @@ int RunSlam(const RunArgs& args) {
   if (std::filesystem::exists(args.out) && !std::filesystem::is_directory(args.out)) {
     throw InputError(args.out, "exists and is not a directory");
   }
-  SystemOptions options;
-  options.blocking = args.blocking;
+  const std::filesystem::path vocabulary =
+      args.vocabulary.empty() ? DefaultVocabularyPath() : std::filesystem::path(args.vocabulary);
+  SystemOptions options =
+      DefaultRunOptions(args.blocking, std::make_shared<const Vocabulary>(Vocabulary::Load(vocabulary)),
+                        !args.no_loop_closing);
   options.extractor.num_features = args.num_features;
-  // Low-contrast cells: 5 grey levels (extractor default 7) keeps keypoints on the faint marks
-  // of plain walls; the medium-texture route's U-turn facing one stays tracked.
-  options.extractor.min_fast_threshold = 5;
   std::optional<std::filesystem::path> markers_path = dataset.markers_path();
   if (!args.markers.empty()) markers_path = args.markers;
   if (markers_path && !args.no_markers) {
@@ -84,10 +84,6 @@ int RunSlam(const RunArgs& args) {
     options.detector.dictionary = options.marker_map->dictionary;
     options.marker_mapping.unknown_marker_size_m = args.marker_size_m;
   }
-  const std::filesystem::path vocabulary =
-      args.vocabulary.empty() ? DefaultVocabularyPath() : std::filesystem::path(args.vocabulary);
-  options.vocabulary = std::make_shared<const Vocabulary>(Vocabulary::Load(vocabulary));
-  options.places.loop_closing = !args.no_loop_closing;
   const bool markers = options.marker_map.has_value();
   MapReuse reuse;
   if (!args.load_map.empty()) LoadMapForRun(args.load_map, dataset.camera(), reuse);

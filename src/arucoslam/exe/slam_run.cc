@@ -83,6 +83,18 @@ void LoadMapForRun(const std::filesystem::path& path, const CameraModel& camera,
   reuse.loaded = std::move(map);
 }
 
+SystemOptions DefaultRunOptions(bool blocking, std::shared_ptr<const Vocabulary> vocabulary,
+                                bool loop_closing) {
+  SystemOptions options;
+  options.blocking = blocking;
+  // Low-contrast cells: 5 grey levels (extractor default 7) keeps keypoints on the faint marks
+  // of plain walls; the medium-texture route's U-turn facing one stays tracked.
+  options.extractor.min_fast_threshold = 5;
+  options.vocabulary = std::move(vocabulary);
+  options.places.loop_closing = loop_closing;
+  return options;
+}
+
 SlamRunResult RunSlamOnDataset(const Dataset& dataset, const std::string& dataset_label,
                                const SystemOptions& options, bool markers,
                                const std::filesystem::path& out_dir, bool progress,

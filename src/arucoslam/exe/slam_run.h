@@ -5,6 +5,7 @@
 #pragma once
 
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -36,6 +37,12 @@ struct SlamRunResult {
   SystemStats timing;
   std::vector<Eigen::Vector3d> map_points;  // as written to map.ply
 };
+
+// The System options every SLAM run of the tools starts from (`run`, `experiments`): blocking
+// or threaded, the given vocabulary with loop closing on or off, and the extractor's FAST floor
+// for bland walls.
+SystemOptions DefaultRunOptions(bool blocking, std::shared_ptr<const Vocabulary> vocabulary,
+                                bool loop_closing);
 
 // `dataset_label` names the dataset in stats.json; `markers` says whether the run used the
 // sequence's marker map. A progress line goes to stderr when `progress` is set.
