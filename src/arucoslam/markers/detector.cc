@@ -210,7 +210,7 @@ std::vector<MarkerDetection> MarkerDetector::Detect(const cv::Mat& image) const 
       const double cell = 0.25 * detections[i].Perimeter() / cells;
       const std::vector<Quad> quads =
           reuse ? found_quads
-                : FindAprilTagQuadsAround(gray, detections[i].corners, 2.0 * cell + 12.0,
+                : FindAprilTagQuadsAround(gray, detections[i].corners, 1.0 * cell + 8.0,
                                           dictionary_, *parameters_);
       on_april_tag_quad[i] = SnapCornersToQuad(quads, cells, options_.april_tag_quad_match_cells,
                                                detections[i].corners);

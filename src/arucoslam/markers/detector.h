@@ -105,13 +105,15 @@ struct DetectorOptions {
   // threshold line fit is then skipped for it. apriltag_detect_unit: 47 of 47 tags within
   // 1 px of the library's corners (mean 0.005 px). Rendered tag36h11 markers (default
   // options, cells of 2-14 px, blur, JPEG): mean error to the truth 0.10-0.23 px, against
-  // 0.21-0.32 px with cornerSubPix alone. Not used with 2-cell borders (Kalibr AprilGrids):
+  // 0.21-0.32 px with cornerSubPix alone; but 0.17 against 0.12 px from AprilTag quads at 2x
+  // (detector_test.cc). Not used with 2-cell borders (Kalibr AprilGrids):
   // on yac_mocap_aprilgrid the quads put corners 0.37 px (median) from yac's, against 0.13 px,
   // and raise the median reprojection error from 0.30 to 0.47 px (0.29 to 0.46 px on the
   // undistorted images: not lens distortion). Unless the search above used AprilTag quads at
-  // full resolution, the quad fit runs again around each detection: about 3 ms per marker
-  // (CPU time, bench/marker_bench.cc BM_DetectAprilTagDictionary: 20.6 against 8.1 ms per
-  // 640x480 frame with 4 markers; BM_DetectAprilTagPhoto: 287 against 239 ms for 30 tags).
+  // full resolution, the quad fit runs again around each detection (its cost grows with the
+  // area: CPU time, bench/marker_bench.cc BM_DetectAprilTagDictionary: 13.3 against 6.4 ms
+  // per 640x480 frame with 4 tags of 35-65 px; BM_DetectAprilTagPhoto: 217 against 207 ms
+  // for 30 tags of 10-45 px).
   bool april_tag_quad_corners = true;
   double april_tag_quad_match_cells = 1.0;  // > 0
 
