@@ -27,7 +27,7 @@ CameraModel Camera(int width, int height) {
 }
 
 // Four 0.2 m markers 1.5-3 m away, tilted, spread over the image.
-std::vector<SyntheticMarker> Markers() {
+std::vector<SyntheticMarker> Markers(const std::string& dictionary = "DICT_4X4_50") {
   std::vector<SyntheticMarker> markers;
   const Eigen::Matrix3d facing = Eigen::AngleAxisd(0.4, Eigen::Vector3d(0.6, 0.8, 0)) *
                                  Eigen::Vector3d(1, -1, -1).asDiagonal();
@@ -35,6 +35,7 @@ std::vector<SyntheticMarker> Markers() {
       {-0.6, -0.3, 2.0}, {0.5, -0.3, 1.5}, {0.5, 0.4, 3.0}, {-0.5, 0.4, 2.5}};
   for (int i = 0; i < 4; ++i) {
     SyntheticMarker marker;
+    marker.dictionary = dictionary;
     marker.id = 2 * i + 1;
     marker.cam_from_marker = Rigid3(facing, positions[i]);
     markers.push_back(marker);
@@ -56,6 +57,25 @@ void BM_Detect(benchmark::State& state) {
   state.counters["markers"] = static_cast<double>(found);
 }
 BENCHMARK(BM_Detect)->Args({640, 480})->Args({1280, 720})->Unit(benchmark::kMillisecond);
+
+// The default options with tag36h11 markers at 640x480, with the corners moved onto the
+// AprilTag quad fit (1, the default for AprilTag dictionaries) or not (0).
+void BM_DetectAprilTagDictionary(benchmark::State& state) {
+  const std::string dictionary = "DICT_APRILTAG_36h11";
+  const cv::Mat image = RenderSyntheticView(Camera(640, 480), Markers(dictionary), {});
+  DetectorOptions options;
+  options.dictionary = dictionary;
+  options.april_tag_quad_corners = state.range(0) != 0;
+  const MarkerDetector detector(options);
+  size_t found = 0;
+  for (auto _ : state) {
+    const std::vector<MarkerDetection> detections = detector.Detect(image);
+    found = detections.size();
+    benchmark::DoNotOptimize(detections.data());
+  }
+  state.counters["markers"] = static_cast<double>(found);
+}
+BENCHMARK(BM_DetectAprilTagDictionary)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 // The default options at 640x480 with the threshold line fit of the corners (1) or without.
 void BM_DetectThresholdLineFit(benchmark::State& state) {
@@ -98,10 +118,11 @@ BENCHMARK(BM_DetectSmallMarkerOptions)
 
 // The real-photo options of the apriltag_detect_unit test (799x533 photo, tag36h11, AprilTag
 // quads at 2x with the rescue decoder): with and without its contour candidates (first
-// argument 1 or 0) and the threshold line fit of the corners (second argument 1 or 0).
+// argument 1 or 0), the threshold line fit of the corners (second argument 1 or 0) and the
+// corners moved onto the AprilTag quad fit at full resolution (third argument 1 or 0).
 void BM_DetectAprilTagPhoto(benchmark::State& state) {
-  const std::string path = std::string(ARUCOSLAM_TEST_DATA_DIR) +
-                           "/apriltag_detect_unit/34085369442_304b6bafd9_c.jpg";
+  const std::string path =
+      std::string(ARUCOSLAM_TEST_DATA_DIR) + "/apriltag_detect_unit/34085369442_304b6bafd9_c.jpg";
   const cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
   if (image.empty()) {
     state.SkipWithError("apriltag_detect_unit photo missing");
@@ -116,6 +137,7 @@ void BM_DetectAprilTagPhoto(benchmark::State& state) {
   options.rescue_rejected = true;
   options.rescue_contour_candidates = state.range(0) != 0;
   options.threshold_line_fit = state.range(1) != 0;
+  options.april_tag_quad_corners = state.range(2) != 0;
   const MarkerDetector detector(options);
   size_t found = 0;
   for (auto _ : state) {
@@ -126,9 +148,10 @@ void BM_DetectAprilTagPhoto(benchmark::State& state) {
   state.counters["markers"] = static_cast<double>(found);
 }
 BENCHMARK(BM_DetectAprilTagPhoto)
-    ->Args({0, 0})
-    ->Args({1, 0})
-    ->Args({1, 1})
+    ->Args({0, 0, 0})
+    ->Args({1, 0, 0})
+    ->Args({1, 1, 0})
+    ->Args({1, 0, 1})
     ->Unit(benchmark::kMillisecond);
 
 void BM_PreprocessClahe(benchmark::State& state) {

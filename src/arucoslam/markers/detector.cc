@@ -36,7 +36,7 @@ bool DetectorOptions::Check() const {
          dedup_distance_rate >= 0.0 && marker_border_bits >= 1 &&
          (april_tag_quad_decimate == 0.0 || april_tag_quad_decimate >= 1.0) &&
          april_tag_quad_sigma >= 0.0 && upsample >= 1.0 && upsample <= 8.0 && rescue.Check() &&
-         threshold_fit.Check();
+         threshold_fit.Check() && april_tag_quad_match_cells > 0.0;
 }
 
 cv::Ptr<cv::aruco::DetectorParameters> DetectorOptions::ToOpenCv() const {
@@ -131,7 +131,7 @@ std::vector<MarkerDetection> MarkerDetector::Detect(const cv::Mat& image) const 
   const double scale = options_.upsample;
   cv::Mat work = gray;
   if (scale > 1.0) cv::resize(gray, work, cv::Size(), scale, scale, cv::INTER_LINEAR);
-  std::vector<std::vector<cv::Point2f>> corners, rejected;
+  std::vector<std::vector<cv::Point2f>> corners, rejected;  // `corners` kept as found
   std::vector<int> ids;
   cv::aruco::detectMarkers(work, dictionary_, corners, ids, parameters_, rejected);
   // OpenCV 4.6's AprilTag path returns corners with pixel centres at (0.5, 0.5) (the apriltag
@@ -145,11 +145,12 @@ std::vector<MarkerDetection> MarkerDetector::Detect(const cv::Mat& image) const 
   detections.reserve(ids.size());
   for (size_t i = 0; i < ids.size(); ++i) {
     if (corners[i].size() != 4) continue;
-    if (options_.corner_refinement == CornerRefinement::kSubpix) RefineSubpix(work, corners[i]);
+    std::vector<cv::Point2f> refined = corners[i];
+    if (options_.corner_refinement == CornerRefinement::kSubpix) RefineSubpix(work, refined);
     MarkerDetection detection;
     detection.id = ids[i];
     for (int k = 0; k < 4; ++k) {
-      detection.corners[k] = {to_input(corners[i][k].x), to_input(corners[i][k].y)};
+      detection.corners[k] = {to_input(refined[k].x), to_input(refined[k].y)};
     }
     detections.push_back(detection);
   }
@@ -195,16 +196,37 @@ std::vector<MarkerDetection> MarkerDetector::Detect(const cv::Mat& image) const 
       rescue_candidates(contour_rejected);
     }
   }
+  const int cells = dictionary_->markerSize + 2 * options_.marker_border_bits;
+  std::vector<bool> on_april_tag_quad(detections.size(), false);
+  if (options_.april_tag_quad_corners && options_.dictionary.starts_with("DICT_APRILTAG") &&
+      options_.marker_border_bits == 1) {
+    // The main search's quads are the AprilTag ones at full resolution when it used them;
+    // otherwise the quad fit runs around each detection (quiet zone and the threshold's
+    // 3 x 3 tiles included).
+    const bool reuse = options_.corner_refinement == CornerRefinement::kAprilTag && scale == 1.0;
+    const std::vector<Quad> found_quads =
+        reuse ? QuadsFromAprilTagDetection(corners, rejected) : std::vector<Quad>{};
+    for (size_t i = 0; i < detections.size(); ++i) {
+      const double cell = 0.25 * detections[i].Perimeter() / cells;
+      const std::vector<Quad> quads =
+          reuse ? found_quads
+                : FindAprilTagQuadsAround(gray, detections[i].corners, 1.0 * cell + 8.0,
+                                          dictionary_, *parameters_);
+      on_april_tag_quad[i] = SnapCornersToQuad(quads, cells, options_.april_tag_quad_match_cells,
+                                               detections[i].corners);
+    }
+  }
   if (options_.threshold_line_fit) {
-    const int cells = dictionary_->markerSize + 2 * options_.marker_border_bits;
-    for (MarkerDetection& detection : detections) {
-      std::array<cv::Point2f, 4> corners;
+    for (size_t i = 0; i < detections.size(); ++i) {
+      if (on_april_tag_quad[i]) continue;
+      MarkerDetection& detection = detections[i];
+      std::array<cv::Point2f, 4> fitted;
       for (int k = 0; k < 4; ++k) {
-        corners[k] = cv::Point2f(static_cast<float>(detection.corners[k].x()),
-                                 static_cast<float>(detection.corners[k].y()));
+        fitted[k] = cv::Point2f(static_cast<float>(detection.corners[k].x()),
+                                static_cast<float>(detection.corners[k].y()));
       }
-      if (!FitQuadToThreshold(gray, cells, options_.threshold_fit, corners)) continue;
-      for (int k = 0; k < 4; ++k) detection.corners[k] = {corners[k].x, corners[k].y};
+      if (!FitQuadToThreshold(gray, cells, options_.threshold_fit, fitted)) continue;
+      for (int k = 0; k < 4; ++k) detection.corners[k] = {fitted[k].x, fitted[k].y};
     }
   }
   return RemoveDuplicateDetections(std::move(detections), options_.dedup_distance_rate);

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "arucoslam/markers/april_tag_quads.h"
 #include "arucoslam/markers/candidate_decoder.h"
 #include "arucoslam/markers/threshold_line_fit.h"
 
@@ -97,6 +98,24 @@ struct DetectorOptions {
   // 640x480 frame with 4 markers; BM_DetectAprilTagPhoto: 222 against 212 ms for 30 tags).
   bool threshold_line_fit = false;
   ThresholdLineFitOptions threshold_fit;
+  // AprilTag dictionaries (DICT_APRILTAG_*) with the standard 1-cell border only: each
+  // detection, whatever found it, takes the corners of the AprilTag quad fit on the input
+  // image (april_tag_quads.h; where the apriltag library places them) when one of its quads
+  // has every corner within april_tag_quad_match_cells cells of the detection's; the
+  // threshold line fit is then skipped for it. apriltag_detect_unit: 47 of 47 tags within
+  // 1 px of the library's corners (mean 0.005 px). Rendered tag36h11 markers (default
+  // options, cells of 2-14 px, blur, JPEG): mean error to the truth 0.10-0.23 px, against
+  // 0.21-0.32 px with cornerSubPix alone; but 0.17 against 0.12 px from AprilTag quads at 2x
+  // (detector_test.cc). Not used with 2-cell borders (Kalibr AprilGrids):
+  // on yac_mocap_aprilgrid the quads put corners 0.37 px (median) from yac's, against 0.13 px,
+  // and raise the median reprojection error from 0.30 to 0.47 px (0.29 to 0.46 px on the
+  // undistorted images: not lens distortion). Unless the search above used AprilTag quads at
+  // full resolution, the quad fit runs again around each detection (its cost grows with the
+  // area: CPU time, bench/marker_bench.cc BM_DetectAprilTagDictionary: 13.3 against 6.4 ms
+  // per 640x480 frame with 4 tags of 35-65 px; BM_DetectAprilTagPhoto: 217 against 207 ms
+  // for 30 tags of 10-45 px).
+  bool april_tag_quad_corners = true;
+  double april_tag_quad_match_cells = 1.0;  // > 0
 
   bool Check() const;
   cv::Ptr<cv::aruco::DetectorParameters> ToOpenCv() const;
