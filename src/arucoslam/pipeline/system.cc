@@ -7,6 +7,16 @@
 #include "arucoslam/util/logging.h"
 
 namespace arucoslam {
+namespace {
+
+void WaitIgnoringErrors(MarkerDetectorWorker& worker) {
+  try {
+    worker.Wait();
+  } catch (...) {
+  }
+}
+
+}  // namespace
 
 bool SystemOptions::Check() const {
   return extractor.Check() && initializer.Check() && initial_map.Check() && tracker.Check() &&
@@ -32,7 +42,10 @@ System::System(const CameraModel& camera, const SystemOptions& options)
   tracker_ = std::make_unique<Tracker>(*map_, options_.tracker);
   mapper_ = std::make_unique<LocalMapper>(*map_, options_.mapper);
   GuardMarkerKeyframes();
-  if (options_.marker_map) detector_ = std::make_unique<MarkerDetector>(options_.detector);
+  if (options_.marker_map) {
+    detector_ = std::make_unique<MarkerDetector>(options_.detector);
+    detector_worker_ = std::make_unique<MarkerDetectorWorker>(*detector_);
+  }
   MakePlaceRecognition();
   StartMappingThread();
 }
@@ -100,15 +113,25 @@ FrameReport System::ProcessImage(const cv::Mat& grey, double timestamp_s) {
   frame.id = FrameId(num_frames_);
   frame.timestamp_s = timestamp_s;
   frame.camera = camera_;
-  frame.features = extractor_.Extract(grey);
+  // Marker detection runs on the worker's thread meanwhile; the frame waits only for what
+  // is left of it after extraction.
+  if (detector_worker_) detector_worker_->Start(grey);
+  try {
+    frame.features = extractor_.Extract(grey);
+  } catch (...) {
+    if (detector_worker_) WaitIgnoringErrors(*detector_worker_);
+    throw;
+  }
   UndistortFeatures(camera_, &frame.features);
   frame.ResetMatches();
   const double extraction = watch.ElapsedMilliseconds();
   std::vector<MarkerDetection> detections;
-  if (detector_) {
-    const Stopwatch detection;
-    detections = detector_->Detect(grey);
-    detection_ms_ = detection.ElapsedMilliseconds();
+  if (detector_worker_) {
+    const Stopwatch waiting;
+    TimedDetections detected = detector_worker_->Wait();
+    marker_wait_ms_ = waiting.ElapsedMilliseconds();
+    detection_ms_ = detected.wall_ms;
+    detections = std::move(detected.detections);
   }
   FrameReport report = ProcessFrame(std::move(frame), detections);
   std::lock_guard lock(stats_mutex_);

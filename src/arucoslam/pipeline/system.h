@@ -21,6 +21,7 @@
 #include "arucoslam/optim/marker_factors.h"
 #include "arucoslam/markers/camera_locator.h"
 #include "arucoslam/markers/detector.h"
+#include "arucoslam/markers/detector_worker.h"
 #include "arucoslam/markers/marker_map.h"
 #include "arucoslam/pipeline/bounded_queue.h"
 #include "arucoslam/pipeline/place_recognition.h"
@@ -186,6 +187,9 @@ struct SystemStats {
   int num_resets = 0;
   int num_keyframes_inserted = 0;
   TimingStats marker_ms;          // per frame with a marker map: detection and location
+  // Per frame with a marker map: what the frame waits for markers (detection runs during
+  // extraction; the time from extraction's end until detections are ready) plus location.
+  TimingStats marker_wait_ms;
   int num_marker_frames = 0;      // frames with a usable marker location
   int num_marker_only_poses = 0;  // frames whose pose came from markers alone
   int num_world_alignments = 0;
@@ -365,6 +369,7 @@ class System {
   std::optional<KeyframeId> pending_keyframe_;  // blocking mode: to map after tracking
 
   std::unique_ptr<MarkerDetector> detector_;  // with a marker map only
+  std::unique_ptr<MarkerDetectorWorker> detector_worker_;  // runs detector_, with it
   std::optional<MarkerFix> fix_;               // the current frame's
   std::optional<MarkerFix> init_reference_fix_;
   std::vector<MarkerAnchor> anchors_;
@@ -383,6 +388,7 @@ class System {
   std::vector<StampedPose> closed_keyframes_;
   std::vector<Eigen::Vector3d> closed_points_;
   double detection_ms_ = 0.0;  // marker detection time of the current image
+  double marker_wait_ms_ = 0.0;  // the current image's wait for its detections
   // Markers of the world-aligned map; only the mapping thread touches it while it runs.
   std::unique_ptr<MarkerMapper> marker_mapper_;
   bool marker_mapping_live_ = false;  // the current map is aligned and feeds marker_mapper_

@@ -84,8 +84,10 @@ std::optional<System::MarkerFix> System::LocateWithMarkers(
     }
   }
   std::lock_guard lock(stats_mutex_);
-  stats_.marker_ms.Add(detection_ms_ + watch.ElapsedMilliseconds());
-  detection_ms_ = 0.0;
+  const double locating_ms = watch.ElapsedMilliseconds();
+  stats_.marker_ms.Add(detection_ms_ + locating_ms);
+  stats_.marker_wait_ms.Add(marker_wait_ms_ + locating_ms);
+  detection_ms_ = marker_wait_ms_ = 0.0;
   if (fix) ++stats_.num_marker_frames;
   return fix;
 }
