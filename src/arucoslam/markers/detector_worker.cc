@@ -29,11 +29,13 @@ MarkerDetectorWorker::~MarkerDetectorWorker() {
   thread_.join();
 }
 
-void MarkerDetectorWorker::Start(const cv::Mat& image) {
+void MarkerDetectorWorker::Start(const cv::Mat& image,
+                                 std::optional<std::vector<cv::Rect>> regions) {
   {
     std::lock_guard lock(mutex_);
     if (started_) throw std::logic_error("MarkerDetectorWorker::Start before Wait");
     image_ = image;
+    regions_ = std::move(regions);
     started_ = true;
     pending_ = true;
     done_ = false;
@@ -59,13 +61,16 @@ void MarkerDetectorWorker::Run() {
     if (!pending_) return;  // stopped with nothing to do
     pending_ = false;
     const cv::Mat image = image_;
+    const std::optional<std::vector<cv::Rect>> regions = std::move(regions_);
+    regions_.reset();
     lock.unlock();
     TimedDetections result;
     std::exception_ptr error;
     const auto wall_start = std::chrono::steady_clock::now();
     const double cpu_start = ThreadCpuMilliseconds();
     try {
-      result.detections = detector_.Detect(image);
+      result.detections =
+          regions ? detector_.DetectInRegions(image, *regions) : detector_.Detect(image);
     } catch (...) {
       error = std::current_exception();
     }

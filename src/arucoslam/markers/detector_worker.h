@@ -5,6 +5,7 @@
 #include <condition_variable>
 #include <exception>
 #include <mutex>
+#include <optional>
 #include <opencv2/core.hpp>
 #include <thread>
 #include <vector>
@@ -29,10 +30,12 @@ class MarkerDetectorWorker {
   MarkerDetectorWorker(const MarkerDetectorWorker&) = delete;
   MarkerDetectorWorker& operator=(const MarkerDetectorWorker&) = delete;
 
-  // Starts detecting in `image`, which is shared, not copied: the caller leaves its pixels
-  // unchanged until Wait returns. One detection at a time: throws std::logic_error when the
-  // previous one was not waited for.
-  void Start(const cv::Mat& image);
+  // Starts detecting in `image` (MarkerDetector::Detect), or only in `regions` of it when
+  // given (MarkerDetector::DetectInRegions). The image is shared, not copied: the caller
+  // leaves its pixels unchanged until Wait returns. One detection at a time: throws
+  // std::logic_error when the previous one was not waited for.
+  void Start(const cv::Mat& image,
+             std::optional<std::vector<cv::Rect>> regions = std::nullopt);
   // Blocks until the started detection is done; rethrows what Detect threw. Throws
   // std::logic_error when nothing was started.
   TimedDetections Wait();
@@ -44,6 +47,7 @@ class MarkerDetectorWorker {
   std::mutex mutex_;
   std::condition_variable changed_;
   cv::Mat image_;
+  std::optional<std::vector<cv::Rect>> regions_;
   bool started_ = false;  // a detection was started and not yet waited for
   bool pending_ = false;  // the worker has not picked the started image up yet
   bool done_ = false;

@@ -55,6 +55,21 @@ TEST(MarkerDetectorWorkerTest, SameDetectionsAsDetect) {
   }
 }
 
+// With regions, the worker gives what DetectInRegions gives: here the left half only.
+TEST(MarkerDetectorWorkerTest, RegionsAsDetectInRegions) {
+  const MarkerDetector detector;
+  MarkerDetectorWorker worker(detector);
+  const cv::Mat image = ThreeMarkerView(0);
+  const std::vector<cv::Rect> left = {cv::Rect(0, 0, 320, 480)};
+  const std::vector<MarkerDetection> expected = detector.DetectInRegions(image, left);
+  ASSERT_EQ(expected.size(), 1u);  // the marker at x = -0.6 m
+  worker.Start(image, left);
+  const std::vector<MarkerDetection> found = worker.Wait().detections;
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found[0].id, 0);
+  for (int k = 0; k < 4; ++k) EXPECT_EQ(found[0].corners[k], expected[0].corners[k]);
+}
+
 TEST(MarkerDetectorWorkerTest, ErrorsReachTheCaller) {
   const MarkerDetector detector;
   MarkerDetectorWorker worker(detector);

@@ -29,7 +29,8 @@ bool SystemOptions::Check() const {
          max_realignment_anchors >= min_alignment_anchors && places.Check() &&
          max_marker_disagreement_m > 0.0 && min_frames_between_anchor_keyframes >= 0 &&
          marker_mapping.Check() && new_map_after_lost_s > 0.0 &&
-         min_marker_init_baseline_m > 0.0 && min_marker_init_parallax_deg >= 0.0;
+         min_marker_init_baseline_m > 0.0 && min_marker_init_parallax_deg >= 0.0 &&
+         marker_search.Check();
 }
 
 System::System(const CameraModel& camera, const SystemOptions& options)
@@ -45,6 +46,8 @@ System::System(const CameraModel& camera, const SystemOptions& options)
   if (options_.marker_map) {
     detector_ = std::make_unique<MarkerDetector>(options_.detector);
     detector_worker_ = std::make_unique<MarkerDetectorWorker>(*detector_);
+    marker_search_ =
+        std::make_unique<MarkerSearchPlanner>(camera_, options_.detector, options_.marker_search);
   }
   MakePlaceRecognition();
   StartMappingThread();
@@ -115,7 +118,7 @@ FrameReport System::ProcessImage(const cv::Mat& grey, double timestamp_s) {
   frame.camera = camera_;
   // Marker detection runs on the worker's thread meanwhile; the frame waits only for what
   // is left of it after extraction.
-  if (detector_worker_) detector_worker_->Start(grey);
+  if (detector_worker_) detector_worker_->Start(grey, MarkerSearchRegions());
   try {
     frame.features = extractor_.Extract(grey);
   } catch (...) {
@@ -134,6 +137,8 @@ FrameReport System::ProcessImage(const cv::Mat& grey, double timestamp_s) {
     detections = std::move(detected.detections);
   }
   FrameReport report = ProcessFrame(std::move(frame), detections);
+  if (detector_worker_) RememberMarkerView(report, detections);
+  report.markers = std::move(detections);
   std::lock_guard lock(stats_mutex_);
   stats_.extraction_ms.Add(extraction);
   stats_.frame_ms.Add(watch.ElapsedMilliseconds());
