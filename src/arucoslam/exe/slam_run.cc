@@ -60,7 +60,10 @@ SlamRunStats MakeStats(const std::string& dataset_label, const Dataset& dataset,
     out.timings_ms.push_back(
         {"global_bundle_adjustment", stats.places.global_bundle_adjustment_ms.Summarize()});
   }
-  if (markers) out.timings_ms.push_back({"markers", stats.marker_ms.Summarize()});
+  if (markers) {
+    out.timings_ms.push_back({"markers", stats.marker_ms.Summarize()});
+    out.timings_ms.push_back({"marker_wait", stats.marker_wait_ms.Summarize()});
+  }
   return out;
 }
 

@@ -122,18 +122,58 @@ void MarkerDetector::RefineSubpix(const cv::Mat& gray, std::vector<cv::Point2f>&
                                     options_.corner_refinement_min_accuracy));
 }
 
-std::vector<MarkerDetection> MarkerDetector::Detect(const cv::Mat& image) const {
-  if (image.empty()) return {};
+namespace {
+
+cv::Mat GreyImage(const cv::Mat& image) {
   cv::Mat gray = image;
   if (image.channels() == 3) cv::cvtColor(image, gray, cv::COLOR_BGR2GRAY);
   if (image.channels() == 4) cv::cvtColor(image, gray, cv::COLOR_BGRA2GRAY);
   if (gray.depth() != CV_8U) throw std::invalid_argument("MarkerDetector: expected 8-bit image");
+  return gray;
+}
+
+}  // namespace
+
+std::vector<MarkerDetection> MarkerDetector::Detect(const cv::Mat& image) const {
+  if (image.empty()) return {};
+  const cv::Mat gray = GreyImage(image);
+  return RemoveDuplicateDetections(DetectInGray(gray, *parameters_, 1.0),
+                                   options_.dedup_distance_rate);
+}
+
+std::vector<MarkerDetection> MarkerDetector::DetectInRegions(
+    const cv::Mat& image, const std::vector<cv::Rect>& regions) const {
+  if (image.empty()) return {};
+  const cv::Mat gray = GreyImage(image);
+  const double whole_side = std::max(gray.cols, gray.rows);
+  std::vector<MarkerDetection> detections;
+  for (const cv::Rect& region : regions) {
+    const cv::Rect part = region & cv::Rect(0, 0, gray.cols, gray.rows);
+    if (part.empty()) continue;
+    // OpenCV's perimeter limits are rates of the searched image's larger side: the part
+    // keeps the whole image's limits in pixels.
+    const double perimeter_scale = whole_side / std::max(part.width, part.height);
+    cv::aruco::DetectorParameters parameters = *parameters_;
+    parameters.minMarkerPerimeterRate *= perimeter_scale;
+    parameters.maxMarkerPerimeterRate *= perimeter_scale;
+    for (MarkerDetection& detection : DetectInGray(gray(part), parameters, perimeter_scale)) {
+      for (Eigen::Vector2d& corner : detection.corners) corner += Eigen::Vector2d(part.x, part.y);
+      detections.push_back(detection);
+    }
+  }
+  return RemoveDuplicateDetections(std::move(detections), options_.dedup_distance_rate);
+}
+
+std::vector<MarkerDetection> MarkerDetector::DetectInGray(
+    const cv::Mat& gray, const cv::aruco::DetectorParameters& parameters,
+    double perimeter_scale) const {
   const double scale = options_.upsample;
   cv::Mat work = gray;
   if (scale > 1.0) cv::resize(gray, work, cv::Size(), scale, scale, cv::INTER_LINEAR);
   std::vector<std::vector<cv::Point2f>> corners, rejected;  // `corners` kept as found
   std::vector<int> ids;
-  cv::aruco::detectMarkers(work, dictionary_, corners, ids, parameters_, rejected);
+  cv::aruco::detectMarkers(work, dictionary_, corners, ids,
+                           cv::makePtr<cv::aruco::DetectorParameters>(parameters), rejected);
   // OpenCV 4.6's AprilTag path returns corners with pixel centres at (0.5, 0.5) (the apriltag
   // library's convention; measured +0.45 px on rendered markers): shift them back.
   const double shift = options_.corner_refinement == CornerRefinement::kAprilTag ? 0.5 : 0.0;
@@ -190,6 +230,8 @@ std::vector<MarkerDetection> MarkerDetector::Detect(const cv::Mat& image) const 
       std::vector<int> contour_ids;
       cv::Ptr<cv::aruco::DetectorParameters> contour_parameters = options_.ToOpenCv();
       contour_parameters->cornerRefinementMethod = cv::aruco::CORNER_REFINE_NONE;
+      contour_parameters->minMarkerPerimeterRate *= perimeter_scale;
+      contour_parameters->maxMarkerPerimeterRate *= perimeter_scale;
       cv::aruco::detectMarkers(work, dictionary_, contour_corners, contour_ids, contour_parameters,
                                contour_rejected);
       rescue_candidates(contour_corners);
@@ -229,7 +271,7 @@ std::vector<MarkerDetection> MarkerDetector::Detect(const cv::Mat& image) const 
       for (int k = 0; k < 4; ++k) detection.corners[k] = {fitted[k].x, fitted[k].y};
     }
   }
-  return RemoveDuplicateDetections(std::move(detections), options_.dedup_distance_rate);
+  return detections;
 }
 
 }  // namespace arucoslam

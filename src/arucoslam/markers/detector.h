@@ -129,11 +129,24 @@ class MarkerDetector {
   // `image`: 8-bit grey or BGR (converted to grey). Detections are sorted by id, then by
   // position; each id appears once per physical marker.
   std::vector<MarkerDetection> Detect(const cv::Mat& image) const;
+  // Detect on the parts `regions` of the image only (clipped to it): each part is searched
+  // as a whole image would be, with the whole image's perimeter limits in pixels. A marker
+  // lying in one region at least MarkerRegionMargin(options) pixels from its sides
+  // (detector_regions.h) is found as Detect finds it (same id, same corners); overlapping
+  // regions should be merged beforehand (SearchRegions does). Cheaper than Detect in
+  // proportion to the area searched.
+  std::vector<MarkerDetection> DetectInRegions(const cv::Mat& image,
+                                               const std::vector<cv::Rect>& regions) const;
 
   const DetectorOptions& options() const { return options_; }
 
  private:
   void RefineSubpix(const cv::Mat& gray, std::vector<cv::Point2f>& corners) const;
+  // Detections in `gray` (the whole image or a part of it; `perimeter_scale` is what the
+  // part multiplies the perimeter rates by), duplicates not yet removed.
+  std::vector<MarkerDetection> DetectInGray(const cv::Mat& gray,
+                                            const cv::aruco::DetectorParameters& parameters,
+                                            double perimeter_scale) const;
 
   DetectorOptions options_;
   cv::Ptr<cv::aruco::Dictionary> dictionary_;

@@ -7,6 +7,16 @@
 #include "arucoslam/util/logging.h"
 
 namespace arucoslam {
+namespace {
+
+void WaitIgnoringErrors(MarkerDetectorWorker& worker) {
+  try {
+    worker.Wait();
+  } catch (...) {
+  }
+}
+
+}  // namespace
 
 bool SystemOptions::Check() const {
   return extractor.Check() && initializer.Check() && initial_map.Check() && tracker.Check() &&
@@ -19,7 +29,8 @@ bool SystemOptions::Check() const {
          max_realignment_anchors >= min_alignment_anchors && places.Check() &&
          max_marker_disagreement_m > 0.0 && min_frames_between_anchor_keyframes >= 0 &&
          marker_mapping.Check() && new_map_after_lost_s > 0.0 &&
-         min_marker_init_baseline_m > 0.0 && min_marker_init_parallax_deg >= 0.0;
+         min_marker_init_baseline_m > 0.0 && min_marker_init_parallax_deg >= 0.0 &&
+         marker_search.Check();
 }
 
 System::System(const CameraModel& camera, const SystemOptions& options)
@@ -32,7 +43,12 @@ System::System(const CameraModel& camera, const SystemOptions& options)
   tracker_ = std::make_unique<Tracker>(*map_, options_.tracker);
   mapper_ = std::make_unique<LocalMapper>(*map_, options_.mapper);
   GuardMarkerKeyframes();
-  if (options_.marker_map) detector_ = std::make_unique<MarkerDetector>(options_.detector);
+  if (options_.marker_map) {
+    detector_ = std::make_unique<MarkerDetector>(options_.detector);
+    detector_worker_ = std::make_unique<MarkerDetectorWorker>(*detector_);
+    marker_search_ =
+        std::make_unique<MarkerSearchPlanner>(camera_, options_.detector, options_.marker_search);
+  }
   MakePlaceRecognition();
   StartMappingThread();
 }
@@ -100,17 +116,29 @@ FrameReport System::ProcessImage(const cv::Mat& grey, double timestamp_s) {
   frame.id = FrameId(num_frames_);
   frame.timestamp_s = timestamp_s;
   frame.camera = camera_;
-  frame.features = extractor_.Extract(grey);
+  // Marker detection runs on the worker's thread meanwhile; the frame waits only for what
+  // is left of it after extraction.
+  if (detector_worker_) detector_worker_->Start(grey, MarkerSearchRegions());
+  try {
+    frame.features = extractor_.Extract(grey);
+  } catch (...) {
+    if (detector_worker_) WaitIgnoringErrors(*detector_worker_);
+    throw;
+  }
   UndistortFeatures(camera_, &frame.features);
   frame.ResetMatches();
   const double extraction = watch.ElapsedMilliseconds();
   std::vector<MarkerDetection> detections;
-  if (detector_) {
-    const Stopwatch detection;
-    detections = detector_->Detect(grey);
-    detection_ms_ = detection.ElapsedMilliseconds();
+  if (detector_worker_) {
+    const Stopwatch waiting;
+    TimedDetections detected = detector_worker_->Wait();
+    marker_wait_ms_ = waiting.ElapsedMilliseconds();
+    detection_ms_ = detected.wall_ms;
+    detections = std::move(detected.detections);
   }
   FrameReport report = ProcessFrame(std::move(frame), detections);
+  if (detector_worker_) RememberMarkerView(report, detections);
+  report.markers = std::move(detections);
   std::lock_guard lock(stats_mutex_);
   stats_.extraction_ms.Add(extraction);
   stats_.frame_ms.Add(watch.ElapsedMilliseconds());

@@ -21,6 +21,8 @@
 #include "arucoslam/optim/marker_factors.h"
 #include "arucoslam/markers/camera_locator.h"
 #include "arucoslam/markers/detector.h"
+#include "arucoslam/markers/detector_regions.h"
+#include "arucoslam/markers/detector_worker.h"
 #include "arucoslam/markers/marker_map.h"
 #include "arucoslam/pipeline/bounded_queue.h"
 #include "arucoslam/pipeline/place_recognition.h"
@@ -61,6 +63,13 @@ struct SystemOptions {
   // aligned frames are optimised with the markers' corners. Unset: keypoints only.
   std::optional<MarkerMap> marker_map;
   DetectorOptions detector;
+  // Where each image's markers are searched: the whole image every full_scan_interval
+  // frames and whenever the previous frame has no pose in the marker world, else around the
+  // known (and mapped) markers projected with that pose and the previous frame's detections
+  // (MarkerDetector::DetectInRegions, about 10x cheaper). Markers missing from marker_map
+  // are found at the whole-image searches, then followed. full_scan_interval 1: always the
+  // whole image.
+  MarkerSearchOptions marker_search;
   CameraLocatorOptions locator;
   // Anchor outliers beyond 0.25 m: a single marker's pose at a few metres is off by 5-10 cm
   // in rendered sequences (measured), more than WorldAlignmentOptions' 0.10 m default allows.
@@ -174,6 +183,7 @@ struct FrameReport {
   int num_inliers = 0;
   std::string message;  // initialisation outcome or loss, for logs
   int num_markers = 0;        // known markers detected (marker map only)
+  std::vector<MarkerDetection> markers;  // all markers detected in the image (ProcessImage)
   bool marker_pose = false;   // the pose comes from the markers alone
   bool world_aligned = false; // the keypoint map is in the marker world frame (metric)
 };
@@ -193,6 +203,10 @@ struct SystemStats {
   int num_resets = 0;
   int num_keyframes_inserted = 0;
   TimingStats marker_ms;          // per frame with a marker map: detection and location
+  // Per frame with a marker map: what the frame waits for markers (detection runs during
+  // extraction; the time from extraction's end until detections are ready) plus location.
+  TimingStats marker_wait_ms;
+  int num_full_marker_scans = 0;  // frames whose markers were searched in the whole image
   int num_marker_frames = 0;      // frames with a usable marker location
   int num_marker_disambiguations = 0;  // ... of which one ambiguous marker settled by motion
   int num_marker_only_poses = 0;  // frames whose pose came from markers alone
@@ -376,6 +390,13 @@ class System {
   std::optional<KeyframeId> pending_keyframe_;  // blocking mode: to map after tracking
 
   std::unique_ptr<MarkerDetector> detector_;  // with a marker map only
+  std::unique_ptr<MarkerDetectorWorker> detector_worker_;  // runs detector_, with it
+  std::unique_ptr<MarkerSearchPlanner> marker_search_;     // with detector_
+  // Where the current image's markers are searched (nullopt: the whole image), and after
+  // the frame, what the next one's search needs (system_marker_search.cc).
+  std::optional<std::vector<cv::Rect>> MarkerSearchRegions();
+  void RememberMarkerView(const FrameReport& report,
+                          const std::vector<MarkerDetection>& detections);
   std::optional<MarkerFix> fix_;               // the current frame's
   std::optional<MarkerFix> init_reference_fix_;
   WorldMotionPrior fix_motion_{options_.fix_motion};  // the recent fixes' world poses
@@ -395,6 +416,7 @@ class System {
   std::vector<StampedPose> closed_keyframes_;
   std::vector<Eigen::Vector3d> closed_points_;
   double detection_ms_ = 0.0;  // marker detection time of the current image
+  double marker_wait_ms_ = 0.0;  // the current image's wait for its detections
   // Markers of the world-aligned map; only the mapping thread touches it while it runs.
   std::unique_ptr<MarkerMapper> marker_mapper_;
   bool marker_mapping_live_ = false;  // the current map is aligned and feeds marker_mapper_

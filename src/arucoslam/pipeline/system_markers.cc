@@ -114,13 +114,15 @@ std::optional<System::MarkerFix> System::LocateWithMarkers(
     }
   }
   std::lock_guard lock(stats_mutex_);
-  stats_.marker_ms.Add(detection_ms_ + watch.ElapsedMilliseconds());
-  detection_ms_ = 0.0;
+  const double locating_ms = watch.ElapsedMilliseconds();
+  stats_.marker_ms.Add(detection_ms_ + locating_ms);
+  stats_.marker_wait_ms.Add(marker_wait_ms_ + locating_ms);
+  detection_ms_ = marker_wait_ms_ = 0.0;
   if (fix) {
     fix_motion_.Add(frame.timestamp_s, fix->world_from_cam);
     ++stats_.num_marker_frames;
-    if (fix->disambiguated_by_motion) ++stats_.num_marker_disambiguations;
     if (fix->disambiguated_by_motion) {
+      ++stats_.num_marker_disambiguations;
       ARUCOSLAM_LOG_DEBUG("frame {}: ambiguous marker {} settled by the motion prediction{}",
                           report.index, location.marker_ids.front(),
                           alternative ? " (IPPE's second solution)" : "");
