@@ -44,12 +44,7 @@ TEST(AprilTagQuadsTest, KeepsCornersWhenNoQuadIsWithinTheTolerance) {
 // On a rendered tag36h11 marker the AprilTag quad fit finds a quad within 0.3 px of the
 // projected corners (OpenCV's pixel centres).
 TEST(AprilTagQuadsTest, FindsTheQuadOfARenderedTag) {
-  CameraModel camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 500.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
+  const CameraModel camera = SyntheticCamera640();
   SyntheticMarker marker;
   marker.dictionary = "DICT_APRILTAG_36h11";
   marker.id = 7;

@@ -19,16 +19,6 @@
 namespace arucoslam {
 namespace {
 
-CameraModel Camera640() {
-  CameraModel camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 500.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
-  return camera;
-}
-
 // A marker facing the camera, tilted by `tilt` about a random axis, rolled randomly.
 Rigid3 RandomCamFromMarker(const Eigen::Vector3d& position, double tilt, std::mt19937& rng) {
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
@@ -80,9 +70,9 @@ Trial RunTrial(const std::vector<Rigid3>& cam_from_markers, const Rigid3& world_
   view.blur_sigma_px = 0.8;
   view.noise_sigma = 3.0;
   view.background_mean = seed % 2 ? 128.0 : 70.0;
-  const cv::Mat image = RenderSyntheticView(Camera640(), markers, view);
+  const cv::Mat image = RenderSyntheticView(SyntheticCamera640(), markers, view);
   const auto detections = MarkerDetector().Detect(image);
-  const CameraLocation location = LocateCamera(detections, map, Camera640());
+  const CameraLocation location = LocateCamera(detections, map, SyntheticCamera640());
   trial.found = location.found;
   if (!location.found) return trial;
   trial.position_error = (location.world_from_cam.translation - world_from_cam.translation).norm();
@@ -96,8 +86,8 @@ Trial RunTrial(const std::vector<Rigid3>& cam_from_markers, const Rigid3& world_
 bool InsideImage(const Rigid3& cam_from_marker) {
   SyntheticMarker marker;
   marker.cam_from_marker = cam_from_marker;
-  for (const Eigen::Vector2d& corner : ProjectMarkerCorners(Camera640(), marker)) {
-    if (!Camera640().InImage(corner, 5.0)) return false;
+  for (const Eigen::Vector2d& corner : ProjectMarkerCorners(SyntheticCamera640(), marker)) {
+    if (!SyntheticCamera640().InImage(corner, 5.0)) return false;
   }
   return true;
 }
@@ -221,8 +211,8 @@ TEST(CameraLocatorTest, WrongMarkerInMapIsRejectedByRansac) {
     if (i == 2) info.world_from_marker.translation += Eigen::Vector3d(0.5, 0.0, 0.0);  // moved
     map.markers[i] = info;
   }
-  const cv::Mat image = RenderSyntheticView(Camera640(), markers, {});
-  const CameraLocation location = LocateCamera(MarkerDetector().Detect(image), map, Camera640());
+  const cv::Mat image = RenderSyntheticView(SyntheticCamera640(), markers, {});
+  const CameraLocation location = LocateCamera(MarkerDetector().Detect(image), map, SyntheticCamera640());
   ASSERT_TRUE(location.found);
   EXPECT_EQ(location.marker_ids, (std::vector<int>{0, 1, 3}));
   EXPECT_EQ(location.quality.num_corners, 16);
@@ -235,7 +225,7 @@ TEST(CameraLocatorTest, NoKnownMarkerIsAValue) {
   std::vector<MarkerDetection> detections(1);
   detections[0].id = 9;
   for (int k = 0; k < 4; ++k) detections[0].corners[k] = Eigen::Vector2d(100 + 10 * k, 100);
-  const CameraLocation location = LocateCamera(detections, MarkerMap(), Camera640());
+  const CameraLocation location = LocateCamera(detections, MarkerMap(), SyntheticCamera640());
   EXPECT_FALSE(location.found);
   EXPECT_FALSE(location.failure.empty());
   EXPECT_EQ(location.unknown_marker_ids, (std::vector<int>{9}));
@@ -270,12 +260,12 @@ AmbiguousView MakeSingleMarkerView(double depth, double tilt_deg, double azimuth
   detection.id = info.id;
   const std::array<Eigen::Vector3d, 4> corners = SquareCorners(size);
   for (int c = 0; c < 4; ++c) {
-    detection.corners[c] = *Camera640().Project(cam_from_marker * corners[c]) +
+    detection.corners[c] = *SyntheticCamera640().Project(cam_from_marker * corners[c]) +
                            Eigen::Vector2d(noise(rng), noise(rng));
   }
   AmbiguousView view;
   view.world_from_cam = info.world_from_marker * cam_from_marker.Inverse();
-  view.location = LocateCamera({detection}, map, Camera640());
+  view.location = LocateCamera({detection}, map, SyntheticCamera640());
   return view;
 }
 

@@ -10,16 +10,6 @@
 namespace arucoslam {
 namespace {
 
-CameraModel Camera640() {
-  CameraModel camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 500.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
-  return camera;
-}
-
 // Given its true corners, perturbed by up to 1 px and starting at any of the four corners in
 // either winding, a rendered marker decodes to its id with the corners back in OpenCV order.
 TEST(CandidateDecoderTest, DecodesRenderedMarkerFromAnyCornerOrder) {
@@ -38,8 +28,8 @@ TEST(CandidateDecoderTest, DecodesRenderedMarkerFromAnyCornerOrder) {
                Eigen::Vector3d(0.02 * i - 0.1, 0.05, 1.0 + 0.2 * i));
     SyntheticViewOptions view;
     view.seed = 20 + i;
-    const cv::Mat image = RenderSyntheticView(Camera640(), {marker}, view);
-    const auto truth = ProjectMarkerCorners(Camera640(), marker);
+    const cv::Mat image = RenderSyntheticView(SyntheticCamera640(), {marker}, view);
+    const auto truth = ProjectMarkerCorners(SyntheticCamera640(), marker);
     std::array<cv::Point2f, 4> corners;
     const int start = i % 4;
     const bool reversed = i % 2 == 1;
@@ -68,7 +58,7 @@ TEST(CandidateDecoderTest, RandomQuadrilateralsAreNotMarkers) {
   const cv::Ptr<cv::aruco::Dictionary> dictionary = DictionaryFromName("DICT_4X4_50");
   SyntheticViewOptions view;
   view.texture_contrast = 60.0;
-  const cv::Mat textured = RenderSyntheticView(Camera640(), {}, view);
+  const cv::Mat textured = RenderSyntheticView(SyntheticCamera640(), {}, view);
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> centre_x(60, 580), centre_y(60, 420), size(12, 50),
       wobble(-0.2f, 0.2f);

@@ -7,16 +7,6 @@
 namespace arucoslam {
 namespace {
 
-CameraModel Camera640() {
-  CameraModel camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 500.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
-  return camera;
-}
-
 const Eigen::Matrix3d kFacing = Eigen::Vector3d(1, -1, -1).asDiagonal();
 
 // Markers 0-5 (0.2 m) at 1.5 to 4 m, spread over the view, slightly tilted.
@@ -42,7 +32,7 @@ TEST(DetectInRegionsTest, SameAsDetectInsideRegions) {
   const std::vector<SyntheticMarker> markers = SpreadMarkers();
   SyntheticViewOptions view;
   view.noise_sigma = 2.0;
-  const cv::Mat image = RenderSyntheticView(Camera640(), markers, view);
+  const cv::Mat image = RenderSyntheticView(SyntheticCamera640(), markers, view);
   const std::vector<MarkerDetection> whole = detector.Detect(image);
   ASSERT_EQ(whole.size(), markers.size());
   std::vector<PixelQuad> quads;
@@ -56,7 +46,7 @@ TEST(DetectInRegionsTest, SameAsDetectInsideRegions) {
         map.markers[info.id] = info;
         return map;
       }(),
-      Camera640(), Rigid3::Identity())[0]);
+      SyntheticCamera640(), Rigid3::Identity())[0]);
   const std::vector<cv::Rect> regions =
       SearchRegions(quads, image.size(), 0.2, MarkerRegionMargin(detector.options()));
   ASSERT_FALSE(regions.empty());
@@ -79,7 +69,7 @@ TEST(DetectInRegionsTest, KeepsTheWholeImagesPerimeterLimits) {
   const MarkerDetector detector(options);
   SyntheticMarker marker;
   marker.cam_from_marker = Rigid3(kFacing, Eigen::Vector3d(0.0, 0.0, 2.5));  // 40 px side
-  const cv::Mat image = RenderSyntheticView(Camera640(), {marker});
+  const cv::Mat image = RenderSyntheticView(SyntheticCamera640(), {marker});
   ASSERT_TRUE(detector.Detect(image).empty());
   EXPECT_TRUE(detector.DetectInRegions(image, {cv::Rect(260, 180, 120, 120)}).empty());
   const MarkerDetector loose;  // default 0.03: found in the same region
@@ -113,7 +103,7 @@ TEST(ProjectMarkerQuadsTest, OnlyMarkersFacingTheCameraInFront) {
   add(1, Rigid3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.5, 0, 2)));     // back side
   add(2, Rigid3(kFacing, Eigen::Vector3d(0, 0, -2)));                          // behind
   const std::vector<PixelQuad> quads =
-      ProjectMarkerQuads(map, Camera640(), Rigid3::Identity());
+      ProjectMarkerQuads(map, SyntheticCamera640(), Rigid3::Identity());
   ASSERT_EQ(quads.size(), 1u);
   // 0.2 m at 2 m, f 500: 50 px side around the centre; top-left corner first.
   EXPECT_NEAR(quads[0][0].x(), 319.5 - 25.0, 1e-9);
@@ -134,13 +124,13 @@ TEST(MarkerSearchPlannerTest, WholeImageOnScheduleRegionsInBetween) {
     info.world_from_marker = marker.cam_from_marker;
     map.markers[info.id] = info;
   }
-  const cv::Mat image = RenderSyntheticView(Camera640(), markers);
+  const cv::Mat image = RenderSyntheticView(SyntheticCamera640(), markers);
   const std::vector<MarkerDetection> whole = detector.Detect(image);
   ASSERT_EQ(whole.size(), markers.size());
   MarkerSearchOptions options;
   options.full_scan_interval = 3;
   options.pose_margin_px = 8.0;  // exact poses here; six markers would fill half the image
-  MarkerSearchPlanner planner(Camera640(), detector.options(), options);
+  MarkerSearchPlanner planner(SyntheticCamera640(), detector.options(), options);
   std::vector<bool> full;
   for (int frame = 0; frame < 7; ++frame) {
     const std::optional<std::vector<cv::Rect>> regions = planner.Next(map);

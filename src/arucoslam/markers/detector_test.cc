@@ -17,16 +17,6 @@
 namespace arucoslam {
 namespace {
 
-CameraModel Camera640() {
-  CameraModel camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 500.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
-  return camera;
-}
-
 // A marker at `depth` metres, tilted by `tilt` radians about a random axis across the
 // view, rolled randomly about its normal, placed randomly but wholly inside the image.
 SyntheticMarker RandomMarker(double depth, double tilt, std::mt19937& rng) {
@@ -49,8 +39,8 @@ SyntheticMarker RandomMarker(double depth, double tilt, std::mt19937& rng) {
     const Eigen::Vector3d position(depth * max_x * unit(rng), depth * max_y * unit(rng), depth);
     marker.cam_from_marker = Rigid3(rotation, position);
     inside = true;
-    for (const Eigen::Vector2d& corner : ProjectMarkerCorners(Camera640(), marker)) {
-      inside = inside && Camera640().InImage(corner, 5.0);
+    for (const Eigen::Vector2d& corner : ProjectMarkerCorners(SyntheticCamera640(), marker)) {
+      inside = inside && SyntheticCamera640().InImage(corner, 5.0);
     }
   }
   return marker;
@@ -109,9 +99,9 @@ TEST(MarkerDetectorTest, RecallOnWarpedMarkersUpTo4Metres) {
         const Scene scene = RandomScene(trials, rng);
         SyntheticMarker marker = RandomMarker(depth, tilt_deg * M_PI / 180.0, rng);
         marker.white_level = scene.white_level;
-        const cv::Mat image = RenderSyntheticView(Camera640(), {marker}, scene.view);
+        const cv::Mat image = RenderSyntheticView(SyntheticCamera640(), {marker}, scene.view);
         ++trials;
-        const auto truth = ProjectMarkerCorners(Camera640(), marker);
+        const auto truth = ProjectMarkerCorners(SyntheticCamera640(), marker);
         for (int variant = 0; variant < 2; ++variant) {
           bool hit = false;
           for (const MarkerDetection& d : detectors[variant].Detect(image)) {
@@ -190,8 +180,8 @@ TEST(MarkerDetectorTest, UpsampledCornersKeepPixelCentres) {
         SyntheticViewOptions view;
         view.seed = 50 + i;
         view.noise_sigma = 1.0;
-        const cv::Mat image = RenderSyntheticView(Camera640(), {marker}, view);
-        const auto truth = ProjectMarkerCorners(Camera640(), marker);
+        const cv::Mat image = RenderSyntheticView(SyntheticCamera640(), {marker}, view);
+        const auto truth = ProjectMarkerCorners(SyntheticCamera640(), marker);
         for (const MarkerDetection& d : detector.Detect(image)) {
           ASSERT_EQ(d.id, marker.id);
           for (int k = 0; k < 4; ++k) {
@@ -228,7 +218,7 @@ TEST(MarkerDetectorTest, NarrowQuietZoneOverDarkBackground) {
     marker.cam_from_marker = Rigid3(Eigen::Matrix3d(Eigen::Vector3d(1, -1, -1).asDiagonal()),
                                     Eigen::Vector3d(0.05 * i - 0.2, 0.0, 0.6 + 0.25 * i));
     view.seed = i + 1;
-    const cv::Mat image = RenderSyntheticView(Camera640(), {marker}, view);
+    const cv::Mat image = RenderSyntheticView(SyntheticCamera640(), {marker}, view);
     const auto ours_found = detector.Detect(image);
     const auto default_found = detector_opencv_default.Detect(image);
     ours += std::count_if(ours_found.begin(), ours_found.end(),
@@ -266,8 +256,8 @@ TEST(MarkerDetectorTest, AprilTagRefinementCornersUseOpenCvPixelCentres) {
       SyntheticViewOptions view;
       view.seed = i + 1;
       view.noise_sigma = 1.0;
-      const cv::Mat image = RenderSyntheticView(Camera640(), {marker}, view);
-      const auto truth = ProjectMarkerCorners(Camera640(), marker);
+      const cv::Mat image = RenderSyntheticView(SyntheticCamera640(), {marker}, view);
+      const auto truth = ProjectMarkerCorners(SyntheticCamera640(), marker);
       for (const MarkerDetection& d : detector.Detect(image)) {
         for (int k = 0; k < 4; ++k) {
           offset += d.corners[k] - truth[k];
@@ -326,7 +316,7 @@ TEST(MarkerDetectorTest, ThresholdLineFitCornersOnRenderedMarkers) {
       view.seed = 60 + image_index;
       view.blur_sigma_px = 0.6 + 0.2 * image_index;
       std::vector<uchar> jpeg;
-      cv::imencode(".jpg", RenderSyntheticView(Camera640(), markers, view), jpeg,
+      cv::imencode(".jpg", RenderSyntheticView(SyntheticCamera640(), markers, view), jpeg,
                    {cv::IMWRITE_JPEG_QUALITY, 85});
       const cv::Mat image = cv::imdecode(jpeg, cv::IMREAD_GRAYSCALE);
       for (int variant = 0; variant < variants; ++variant) {
@@ -336,7 +326,7 @@ TEST(MarkerDetectorTest, ThresholdLineFitCornersOnRenderedMarkers) {
           const auto marker = std::find_if(markers.begin(), markers.end(),
                                            [&](const SyntheticMarker& m) { return m.id == d.id; });
           ASSERT_NE(marker, markers.end()) << "no marker " << d.id << " in the image";
-          const std::array<Eigen::Vector2d, 4> truth = ProjectMarkerCorners(Camera640(), *marker);
+          const std::array<Eigen::Vector2d, 4> truth = ProjectMarkerCorners(SyntheticCamera640(), *marker);
           for (int k = 0; k < 4; ++k) error_sum[variant] += (d.corners[k] - truth[k]).norm();
           corners[variant] += 4;
         }
@@ -390,7 +380,7 @@ TEST(MarkerDetectorTest, AprilTagQuadCornersOnRenderedMarkers) {
     view.seed = 10 + image_index;
     view.blur_sigma_px = 0.6 + 0.1 * image_index;
     std::vector<uchar> jpeg;
-    cv::imencode(".jpg", RenderSyntheticView(Camera640(), markers, view), jpeg,
+    cv::imencode(".jpg", RenderSyntheticView(SyntheticCamera640(), markers, view), jpeg,
                  {cv::IMWRITE_JPEG_QUALITY, 90});
     const cv::Mat image = cv::imdecode(jpeg, cv::IMREAD_GRAYSCALE);
     for (const bool quad_corners : {false, true}) {
@@ -399,7 +389,7 @@ TEST(MarkerDetectorTest, AprilTagQuadCornersOnRenderedMarkers) {
         const auto marker = std::find_if(markers.begin(), markers.end(),
                                          [&](const SyntheticMarker& m) { return m.id == d.id; });
         ASSERT_NE(marker, markers.end()) << "no marker " << d.id << " in the image";
-        const std::array<Eigen::Vector2d, 4> truth = ProjectMarkerCorners(Camera640(), *marker);
+        const std::array<Eigen::Vector2d, 4> truth = ProjectMarkerCorners(SyntheticCamera640(), *marker);
         for (int k = 0; k < 4; ++k) error_sum[quad_corners] += (d.corners[k] - truth[k]).norm();
         corners[quad_corners] += 4;
       }

@@ -9,16 +9,6 @@
 namespace arucoslam {
 namespace {
 
-CameraModel Camera640() {
-  CameraModel camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 500.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
-  return camera;
-}
-
 // Three markers facing the camera at 1.5 to 2.5 m, at different places in the view.
 cv::Mat ThreeMarkerView(int first_id) {
   std::vector<SyntheticMarker> markers;
@@ -29,7 +19,7 @@ cv::Mat ThreeMarkerView(int first_id) {
     marker.cam_from_marker = Rigid3(facing, Eigen::Vector3d(-0.6 + 0.6 * i, 0.1 * i, 1.5 + 0.5 * i));
     markers.push_back(marker);
   }
-  return RenderSyntheticView(Camera640(), markers);
+  return RenderSyntheticView(SyntheticCamera640(), markers);
 }
 
 // The worker gives what Detect gives on the caller's thread, image after image.

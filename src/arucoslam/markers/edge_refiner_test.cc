@@ -9,16 +9,6 @@
 namespace arucoslam {
 namespace {
 
-CameraModel Camera640() {
-  CameraModel camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 500.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
-  return camera;
-}
-
 // Small tilted markers (18-40 px, 3-7 px per cell, blurred and noisy): corners displaced by
 // up to 1 px each way come back to the rendered truth.
 TEST(EdgeRefinerTest, SmallMarkerCornersFromDisplacedQuads) {
@@ -38,8 +28,8 @@ TEST(EdgeRefinerTest, SmallMarkerCornersFromDisplacedQuads) {
     view.seed = 70 + i;
     view.blur_sigma_px = 0.8;
     view.noise_sigma = 3.0;
-    const cv::Mat image = RenderSyntheticView(Camera640(), {marker}, view);
-    const auto truth = ProjectMarkerCorners(Camera640(), marker);
+    const cv::Mat image = RenderSyntheticView(SyntheticCamera640(), {marker}, view);
+    const auto truth = ProjectMarkerCorners(SyntheticCamera640(), marker);
     std::array<cv::Point2f, 4> corners;
     for (int k = 0; k < 4; ++k) {
       // ProjectMarkerCorners runs clockwise on screen from the marker's top-left.

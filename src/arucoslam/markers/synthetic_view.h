@@ -38,6 +38,10 @@ struct SyntheticViewOptions {
   bool Check() const;
 };
 
+// The pinhole camera of the synthetic marker tests: 640x480, fx = fy = 500, principal point
+// at the image centre, no distortion.
+CameraModel SyntheticCamera640();
+
 // Renders an 8-bit grey image of camera.width x camera.height. The camera must be a
 // pinhole without distortion (DistortionModel::kNone); markers with any part behind the
 // camera are skipped. Throws std::invalid_argument on bad options or a distorted camera.

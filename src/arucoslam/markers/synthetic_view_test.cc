@@ -8,16 +8,6 @@
 namespace arucoslam {
 namespace {
 
-CameraModel Camera() {
-  CameraModel camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 500.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
-  return camera;
-}
-
 SyntheticMarker FrontoParallel(double depth) {
   SyntheticMarker marker;
   marker.cam_from_marker = Rigid3(Eigen::Matrix3d(Eigen::Vector3d(1, -1, -1).asDiagonal()),
@@ -33,8 +23,8 @@ TEST(SyntheticViewTest, BlackSquareLandsWhereProjected) {
   options.blur_sigma_px = 0.0;
   options.noise_sigma = 0.0;
   const SyntheticMarker marker = FrontoParallel(1.0);
-  const cv::Mat image = RenderSyntheticView(Camera(), {marker}, options);
-  const auto corners = ProjectMarkerCorners(Camera(), marker);
+  const cv::Mat image = RenderSyntheticView(SyntheticCamera640(), {marker}, options);
+  const auto corners = ProjectMarkerCorners(SyntheticCamera640(), marker);
   EXPECT_NEAR(corners[0].x(), 269.5, 1e-9);
   EXPECT_NEAR(corners[0].y(), 189.5, 1e-9);
   EXPECT_NEAR(corners[2].x(), 369.5, 1e-9);
@@ -50,11 +40,11 @@ TEST(SyntheticViewTest, BlackSquareLandsWhereProjected) {
 TEST(SyntheticViewTest, NoiseAndTextureAreDeterministicAndSized) {
   SyntheticViewOptions options;
   options.seed = 7;
-  const cv::Mat a = RenderSyntheticView(Camera(), {FrontoParallel(2.0)}, options);
-  const cv::Mat b = RenderSyntheticView(Camera(), {FrontoParallel(2.0)}, options);
+  const cv::Mat a = RenderSyntheticView(SyntheticCamera640(), {FrontoParallel(2.0)}, options);
+  const cv::Mat b = RenderSyntheticView(SyntheticCamera640(), {FrontoParallel(2.0)}, options);
   EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0.0);
   options.seed = 8;
-  const cv::Mat c = RenderSyntheticView(Camera(), {FrontoParallel(2.0)}, options);
+  const cv::Mat c = RenderSyntheticView(SyntheticCamera640(), {FrontoParallel(2.0)}, options);
   EXPECT_GT(cv::norm(a, c, cv::NORM_INF), 10.0);
   // Texture standard deviation away from the marker is near what was asked for.
   cv::Scalar mean, stddev;
@@ -64,13 +54,13 @@ TEST(SyntheticViewTest, NoiseAndTextureAreDeterministicAndSized) {
 }
 
 TEST(SyntheticViewTest, RejectsDistortedCameraAndBadOptions) {
-  CameraModel camera = Camera();
+  CameraModel camera = SyntheticCamera640();
   camera.model = DistortionModel::kRadTan;
   EXPECT_THROW(RenderSyntheticView(camera, {}, {}), std::invalid_argument);
   SyntheticViewOptions options;
   options.supersampling = 0;
   EXPECT_FALSE(options.Check());
-  EXPECT_THROW(RenderSyntheticView(Camera(), {}, options), std::invalid_argument);
+  EXPECT_THROW(RenderSyntheticView(SyntheticCamera640(), {}, options), std::invalid_argument);
 }
 
 }  // namespace

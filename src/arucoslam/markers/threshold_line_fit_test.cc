@@ -13,16 +13,6 @@
 namespace arucoslam {
 namespace {
 
-CameraModel Camera640() {
-  CameraModel camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 500.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
-  return camera;
-}
-
 cv::Mat ThroughJpeg(const cv::Mat& image, int quality) {
   std::vector<uchar> bytes;
   cv::imencode(".jpg", image, bytes, {cv::IMWRITE_JPEG_QUALITY, quality});
@@ -70,9 +60,9 @@ TEST(ThresholdLineFitTest, SmallTiltedTagsFromDisplacedQuads) {
     SyntheticViewOptions view;
     view.seed = 40 + image_index;
     view.blur_sigma_px = 0.6 + 0.15 * image_index;
-    const cv::Mat image = ThroughJpeg(RenderSyntheticView(Camera640(), markers, view), 85);
+    const cv::Mat image = ThroughJpeg(RenderSyntheticView(SyntheticCamera640(), markers, view), 85);
     for (const SyntheticMarker& marker : markers) {
-      const std::array<Eigen::Vector2d, 4> truth = ProjectMarkerCorners(Camera640(), marker);
+      const std::array<Eigen::Vector2d, 4> truth = ProjectMarkerCorners(SyntheticCamera640(), marker);
       std::array<cv::Point2f, 4> start = ToPoints(truth);
       for (cv::Point2f& corner : start) corner += cv::Point2f(jitter(rng), jitter(rng));
       ++tried;
@@ -131,8 +121,8 @@ TEST(ThresholdLineFitTest, AcuteCornersOfTagsSeenEdgeOn) {
     view.background = SyntheticBackground::kUniform;
     view.background_mean = 200.0;
     view.blur_sigma_px = 0.7 + 0.4 * unit(rng);
-    const cv::Mat image = ThroughJpeg(RenderSyntheticView(Camera640(), {marker}, view), 85);
-    const std::array<Eigen::Vector2d, 4> truth = ProjectMarkerCorners(Camera640(), marker);
+    const cv::Mat image = ThroughJpeg(RenderSyntheticView(SyntheticCamera640(), {marker}, view), 85);
+    const std::array<Eigen::Vector2d, 4> truth = ProjectMarkerCorners(SyntheticCamera640(), marker);
     std::array<cv::Point2f, 4> corners = ToPoints(truth);
     for (cv::Point2f& corner : corners) corner += cv::Point2f(jitter(rng), jitter(rng));
     ++tried;
