@@ -43,11 +43,10 @@ std::vector<SyntheticMarker> Markers(const std::string& dictionary = "DICT_4X4_5
   return markers;
 }
 
-void BM_Detect(benchmark::State& state) {
-  const CameraModel camera =
-      Camera(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
-  const cv::Mat image = RenderSyntheticView(camera, Markers(), {});
-  const MarkerDetector detector;
+// The timed loop of the detection benchmarks: `detector` on `image`, the markers it finds
+// as a counter.
+void TimeDetection(benchmark::State& state, const MarkerDetector& detector,
+                   const cv::Mat& image) {
   size_t found = 0;
   for (auto _ : state) {
     const std::vector<MarkerDetection> detections = detector.Detect(image);
@@ -55,6 +54,14 @@ void BM_Detect(benchmark::State& state) {
     benchmark::DoNotOptimize(detections.data());
   }
   state.counters["markers"] = static_cast<double>(found);
+}
+
+void BM_Detect(benchmark::State& state) {
+  const CameraModel camera =
+      Camera(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  const cv::Mat image = RenderSyntheticView(camera, Markers(), {});
+  const MarkerDetector detector;
+  TimeDetection(state, detector, image);
 }
 BENCHMARK(BM_Detect)->Args({640, 480})->Args({1280, 720})->Unit(benchmark::kMillisecond);
 
@@ -67,13 +74,7 @@ void BM_DetectAprilTagDictionary(benchmark::State& state) {
   options.dictionary = dictionary;
   options.april_tag_quad_corners = state.range(0) != 0;
   const MarkerDetector detector(options);
-  size_t found = 0;
-  for (auto _ : state) {
-    const std::vector<MarkerDetection> detections = detector.Detect(image);
-    found = detections.size();
-    benchmark::DoNotOptimize(detections.data());
-  }
-  state.counters["markers"] = static_cast<double>(found);
+  TimeDetection(state, detector, image);
 }
 BENCHMARK(BM_DetectAprilTagDictionary)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
@@ -83,13 +84,7 @@ void BM_DetectThresholdLineFit(benchmark::State& state) {
   DetectorOptions options;
   options.threshold_line_fit = state.range(0) != 0;
   const MarkerDetector detector(options);
-  size_t found = 0;
-  for (auto _ : state) {
-    const std::vector<MarkerDetection> detections = detector.Detect(image);
-    found = detections.size();
-    benchmark::DoNotOptimize(detections.data());
-  }
-  state.counters["markers"] = static_cast<double>(found);
+  TimeDetection(state, detector, image);
 }
 BENCHMARK(BM_DetectThresholdLineFit)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
@@ -101,13 +96,7 @@ void BM_DetectSmallMarkerOptions(benchmark::State& state) {
   options.upsample = 0.1 * static_cast<double>(state.range(0));
   options.rescue_rejected = state.range(1) != 0;
   const MarkerDetector detector(options);
-  size_t found = 0;
-  for (auto _ : state) {
-    const std::vector<MarkerDetection> detections = detector.Detect(image);
-    found = detections.size();
-    benchmark::DoNotOptimize(detections.data());
-  }
-  state.counters["markers"] = static_cast<double>(found);
+  TimeDetection(state, detector, image);
 }
 BENCHMARK(BM_DetectSmallMarkerOptions)
     ->Args({10, 1})
@@ -139,13 +128,7 @@ void BM_DetectAprilTagPhoto(benchmark::State& state) {
   options.threshold_line_fit = state.range(1) != 0;
   options.april_tag_quad_corners = state.range(2) != 0;
   const MarkerDetector detector(options);
-  size_t found = 0;
-  for (auto _ : state) {
-    const std::vector<MarkerDetection> detections = detector.Detect(image);
-    found = detections.size();
-    benchmark::DoNotOptimize(detections.data());
-  }
-  state.counters["markers"] = static_cast<double>(found);
+  TimeDetection(state, detector, image);
 }
 BENCHMARK(BM_DetectAprilTagPhoto)
     ->Args({0, 0, 0})

@@ -13,7 +13,6 @@
 // The sequence (EuRoC layout with a markers.json and ground truth) is named by
 // ARUCOSLAM_BENCH_SEQUENCE; the benchmark is skipped without it.
 #include <benchmark/benchmark.h>
-#include <time.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -32,12 +31,6 @@
 
 namespace arucoslam {
 namespace {
-
-double ProcessCpuMilliseconds() {
-  timespec now{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &now);
-  return 1e3 * static_cast<double>(now.tv_sec) + 1e-6 * static_cast<double>(now.tv_nsec);
-}
 
 double Median(std::vector<double> values) {
   std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());

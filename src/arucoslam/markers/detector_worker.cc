@@ -1,21 +1,11 @@
 #include "arucoslam/markers/detector_worker.h"
 
-#include <time.h>
-
-#include <chrono>
 #include <stdexcept>
 #include <utility>
 
+#include "arucoslam/util/timing.h"
+
 namespace arucoslam {
-namespace {
-
-double ThreadCpuMilliseconds() {
-  timespec now{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
-  return 1e3 * static_cast<double>(now.tv_sec) + 1e-6 * static_cast<double>(now.tv_nsec);
-}
-
-}  // namespace
 
 MarkerDetectorWorker::MarkerDetectorWorker(const MarkerDetector& detector)
     : detector_(detector), thread_([this] { Run(); }) {}
@@ -66,7 +56,7 @@ void MarkerDetectorWorker::Run() {
     lock.unlock();
     TimedDetections result;
     std::exception_ptr error;
-    const auto wall_start = std::chrono::steady_clock::now();
+    const Stopwatch wall;
     const double cpu_start = ThreadCpuMilliseconds();
     try {
       result.detections =
@@ -75,9 +65,7 @@ void MarkerDetectorWorker::Run() {
       error = std::current_exception();
     }
     result.cpu_ms = ThreadCpuMilliseconds() - cpu_start;
-    result.wall_ms = std::chrono::duration<double, std::milli>(
-                         std::chrono::steady_clock::now() - wall_start)
-                         .count();
+    result.wall_ms = wall.ElapsedMilliseconds();
     lock.lock();
     result_ = std::move(result);
     error_ = error;

@@ -1,6 +1,7 @@
 #include "arucoslam/util/timing.h"
 
 #include <sys/resource.h>
+#include <time.h>
 
 #include <algorithm>
 #include <cmath>
@@ -29,6 +30,19 @@ TimingSummary TimingStats::Summarize() const {
   summary.max = sorted.back();
   return summary;
 }
+
+namespace {
+
+double CpuMilliseconds(clockid_t clock) {
+  timespec now{};
+  clock_gettime(clock, &now);
+  return 1e3 * static_cast<double>(now.tv_sec) + 1e-6 * static_cast<double>(now.tv_nsec);
+}
+
+}  // namespace
+
+double ThreadCpuMilliseconds() { return CpuMilliseconds(CLOCK_THREAD_CPUTIME_ID); }
+double ProcessCpuMilliseconds() { return CpuMilliseconds(CLOCK_PROCESS_CPUTIME_ID); }
 
 std::size_t PeakMemoryBytes() {
   rusage usage{};

@@ -41,6 +41,11 @@ class TimingStats {
   std::vector<double> samples_;
 };
 
+// CPU time consumed so far, milliseconds: by the calling thread, and by the whole process
+// (every thread, e.g. OpenCV's pool).
+double ThreadCpuMilliseconds();
+double ProcessCpuMilliseconds();
+
 // Peak resident set size of this process in bytes (0 where unknown).
 std::size_t PeakMemoryBytes();
 
