@@ -149,10 +149,9 @@ ExperimentRun KeypointSlamRun(const std::string& label, const std::string& seque
   run.label = label;
   run.sequence = sequence_name;
   const Dataset dataset = Dataset::Open(sequence);
-  const SystemOptions& options = slam;
   if (progress) std::fprintf(stderr, "SLAM, %s\n", label.c_str());
   const SlamRunResult result =
-      RunSlamOnDataset(dataset, sequence.string(), options, /*markers=*/false, out_dir, progress);
+      RunSlamOnDataset(dataset, sequence.string(), slam, /*markers=*/false, out_dir, progress);
   run.available = true;
   run.median_frame_ms = result.timing.frame_ms.Summarize().median;
   run.note = fmt::format(
