@@ -159,6 +159,9 @@ TEST_F(PlacesEndToEnd, ClosingTheLoopAtLeastHalvesTheError) {
               closed.stats.places.loops.size(), closed.stats.places.num_loops_rejected);
   EXPECT_TRUE(open.stats.places.loops.empty());
   ASSERT_GE(closed.stats.places.loops.size(), 1u);
+  // Consistent candidates at look-alike places reached the Sim(3) verification and were
+  // refused (56 measured), and no closed loop is false.
+  EXPECT_GE(closed.stats.places.num_loops_rejected, 5);
   EXPECT_EQ(CountFalseLoops(dataset, closed), 0);
   EXPECT_GE(closed.trajectory.size(), 0.95 * dataset.size());
   EXPECT_GE(open.trajectory.size(), 0.95 * dataset.size());
@@ -219,13 +222,17 @@ TEST_F(PlacesEndToEnd, NoFalseLoopInTheLowTextureFactory) {
       RenderSequence(*dir_, "low", "--seed 1 --texture low --markers off", 20.0, false);
   const Dataset dataset = Dataset::Open(sequence);
   const RunOutcome run = RunSystem(dataset, *vocabulary_, true);
-  std::printf("%zu frames, %zu posed; %d loop candidates verified, %zu closed\n", dataset.size(),
-              run.trajectory.size(), run.stats.places.num_loop_candidates,
-              run.stats.places.loops.size());
+  std::printf("%zu frames, %zu posed; %d database matches, %d loop candidates verified, %zu "
+              "closed\n",
+              dataset.size(), run.trajectory.size(), run.stats.places.num_loop_database_matches,
+              run.stats.places.num_loop_candidates, run.stats.places.loops.size());
   EXPECT_GE(run.stats.places.loop_detection_ms.Count(), 5u);  // keyframes were queried
-  // The route does not come back within 20 s: every candidate is a look-alike place, and
-  // the look-alike racks do pass the BoW consistency check (33 verified when measured).
-  EXPECT_GE(run.stats.places.num_loop_candidates, 1);
+  // The route does not come back within 20 s: a database match outside a keyframe's
+  // neighbourhood is a look-alike rack. How many there are depends on the map: 33 passed the
+  // consistency check once; since new points pair each keyframe with its widest-parallax
+  // neighbour (and take parallax down to 0.26 degrees), 0-2 database matches remain on this
+  // route and on seeds 2 and 3, presumably because covisibility now reaches further back. That the verification refuses look-alikes that do pass the
+  // consistency check is asserted in ClosingTheLoopAtLeastHalvesTheError.
   EXPECT_EQ(CountFalseLoops(dataset, run), 0);
 }
 

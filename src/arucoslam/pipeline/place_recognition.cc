@@ -144,14 +144,16 @@ void PlaceRecognition::DetectAndClose(KeyframeId keyframe) {
   AddToDatabase(keyframe);
   if (!options_.loop_closing) return;
   std::vector<KeyframeId> candidates;
+  LoopDetectionStats detection;
   {
     std::lock_guard lock(database_mutex_);
-    candidates = detector_.DetectByWords(keyframe);
+    candidates = detector_.DetectByWords(keyframe, &detection);
   }
   const double detection_ms = watch.ElapsedMilliseconds();
   {
     std::lock_guard lock(*stats_mutex_);
     stats_->loop_detection_ms.Add(detection_ms);
+    stats_->num_loop_database_matches += detection.num_database_matches;
   }
   for (const KeyframeId& candidate : candidates) {
     const Stopwatch correction;

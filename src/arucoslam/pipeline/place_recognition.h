@@ -55,6 +55,9 @@ struct PlaceRecognitionStats {
   int num_relocalization_attempts = 0;
   TimingStats relocalization_ms;       // per attempt
   TimingStats loop_detection_ms;       // per mapped keyframe: database + detection
+  // Place-database matches of mapped keyframes outside their neighbourhood, before the
+  // consistency check: look-alike places (or true loops) the detector had to judge.
+  int num_loop_database_matches = 0;
   int num_loop_candidates = 0;         // consistent candidates verified
   int num_loops_rejected = 0;          // candidates LoopCloser refused
   std::vector<ClosedLoop> loops;       // closed loops, in order

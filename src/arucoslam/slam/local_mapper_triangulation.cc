@@ -78,8 +78,13 @@ std::vector<FeatureMatch> MatchAlongEpipolarLines(const Keyframe& kf1, const Key
   return FilterByRotationConsistency(matches, angles1, angles2);
 }
 
+struct TriangulatedMatch {
+  Eigen::Vector3d p_in_world;
+  double parallax_cos = 1.0;  // cosine of the angle between the two viewing rays
+};
+
 // The point of a match when it passes every check, else nullopt.
-std::optional<Eigen::Vector3d> TriangulateMatch(const Keyframe& kf1, const Keyframe& kf2,
+std::optional<TriangulatedMatch> TriangulateMatch(const Keyframe& kf1, const Keyframe& kf2,
                                                 const FeatureMatch& match,
                                                 const LocalMapperOptions& options) {
   const Eigen::Vector2d& x1 = kf1.features.undistorted[match.index1];
@@ -88,7 +93,8 @@ std::optional<Eigen::Vector3d> TriangulateMatch(const Keyframe& kf1, const Keyfr
       kf1.cam_from_world.rotation.conjugate() * x1.homogeneous().normalized();
   const Eigen::Vector3d ray2 =
       kf2.cam_from_world.rotation.conjugate() * x2.homogeneous().normalized();
-  if (ray1.dot(ray2) >= options.max_parallax_cos) return std::nullopt;
+  const double parallax_cos = ray1.dot(ray2);
+  if (parallax_cos >= options.max_parallax_cos) return std::nullopt;
   const std::optional<Eigen::Vector3d> point =
       TriangulateDlt(kf1.cam_from_world, kf2.cam_from_world, x1, x2);
   if (!point) return std::nullopt;
@@ -108,7 +114,7 @@ std::optional<Eigen::Vector3d> TriangulateMatch(const Keyframe& kf1, const Keyfr
   if (distance_ratio * factor < octave_ratio || distance_ratio > octave_ratio * factor) {
     return std::nullopt;
   }
-  return point;
+  return TriangulatedMatch{*point, parallax_cos};
 }
 
 double MedianDepth(const MapData& data, const Keyframe& keyframe) {
@@ -128,6 +134,7 @@ struct NewPoint {
   int index1 = 0;
   int index2 = 0;
   Eigen::Vector3d p_in_world;
+  double parallax_cos = 1.0;
 };
 
 }  // namespace
@@ -151,16 +158,24 @@ int LocalMapper::TriangulateNewPoints(KeyframeId keyframe) {
     }
   });
   if (!current) return 0;
-  std::vector<NewPoint> candidates;
-  std::vector<bool> used1(current->features.size(), false);
+  // Each keypoint is triangulated with the neighbour that sees it under the widest parallax.
+  // Taking the first neighbour that passes (the most covisible, usually the nearest) made
+  // the parallax test select, among low-parallax matches, those whose noise widened the
+  // parallax: their points lay too near, and the map's scale shrank as the camera moved.
+  std::vector<std::optional<NewPoint>> widest(current->features.size());
   for (const Keyframe& other : neighbours) {
     for (const FeatureMatch& match : MatchAlongEpipolarLines(*current, other, options_)) {
-      if (used1[match.index1]) continue;
-      if (const auto point = TriangulateMatch(*current, other, match, options_)) {
-        used1[match.index1] = true;
-        candidates.push_back({other.id, match.index1, match.index2, *point});
+      const auto point = TriangulateMatch(*current, other, match, options_);
+      std::optional<NewPoint>& best = widest[match.index1];
+      if (point && (!best || point->parallax_cos < best->parallax_cos)) {
+        best = NewPoint{other.id, match.index1, match.index2, point->p_in_world,
+                        point->parallax_cos};
       }
     }
+  }
+  std::vector<NewPoint> candidates;
+  for (const std::optional<NewPoint>& point : widest) {
+    if (point) candidates.push_back(*point);
   }
   return map_.Write([&](MapData& data) {
     int created = 0;
