@@ -32,17 +32,6 @@
 namespace arucoslam {
 namespace {
 
-double Median(std::vector<double> values) {
-  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-  return values[values.size() / 2];
-}
-
-double Mean(const std::vector<double>& values) {
-  double sum = 0.0;
-  for (double value : values) sum += value;
-  return sum / static_cast<double>(values.size());
-}
-
 // The ground-truth cam_from_world nearest in time to `timestamp_s`.
 Rigid3 TruePose(const Trajectory& truth, double timestamp_s) {
   const auto it = std::lower_bound(truth.timestamps.begin(), truth.timestamps.end(), timestamp_s);
@@ -73,7 +62,7 @@ void BM_MarkerHandlingPerFrame(benchmark::State& state) {
   MarkerDetectorWorker worker(detector);
   const OrbExtractor extractor(system_options.extractor);
   const std::size_t count = std::min<std::size_t>(dataset.size(), 900);
-  std::vector<double> critical, cpu, extraction;
+  TimingStats critical, cpu, extraction;
   int with_markers = 0, full_scans = 0;
   for (auto _ : state) {
     // Pass 1 as ProcessImage: detection overlapping extraction. Pass 2: detection alone.
@@ -90,11 +79,11 @@ void BM_MarkerHandlingPerFrame(benchmark::State& state) {
           const Stopwatch frame;
           worker.Start(image, regions);
           const OrbFeatures features = extractor.Extract(image);
-          extraction.push_back(frame.ElapsedMilliseconds());
+          extraction.Add(frame.ElapsedMilliseconds());
           const Stopwatch waiting;
           detections = worker.Wait().detections;
           const CameraLocation location = LocateCamera(detections, known, dataset.camera());
-          critical.push_back(waiting.ElapsedMilliseconds());
+          critical.Add(waiting.ElapsedMilliseconds());
           benchmark::DoNotOptimize(features.keypoints.size());
           benchmark::DoNotOptimize(location.found);
           with_markers += detections.empty() ? 0 : 1;
@@ -103,7 +92,7 @@ void BM_MarkerHandlingPerFrame(benchmark::State& state) {
           detections =
               regions ? detector.DetectInRegions(image, *regions) : detector.Detect(image);
           const CameraLocation location = LocateCamera(detections, known, dataset.camera());
-          cpu.push_back(ProcessCpuMilliseconds() - start);
+          cpu.Add(ProcessCpuMilliseconds() - start);
           benchmark::DoNotOptimize(location.found);
         }
         planner.Remember(TruePose(dataset.ground_truth(), dataset.frame(i).timestamp_s),
@@ -115,11 +104,12 @@ void BM_MarkerHandlingPerFrame(benchmark::State& state) {
   state.counters["frames"] = static_cast<double>(count);
   state.counters["frames_with_markers"] = with_markers;
   state.counters["full_scans"] = full_scans;
-  state.counters["critical_median_ms"] = Median(critical);
-  state.counters["critical_mean_ms"] = Mean(critical);
-  state.counters["cpu_median_ms"] = Median(cpu);
-  state.counters["cpu_mean_ms"] = Mean(cpu);
-  state.counters["extraction_median_ms"] = Median(extraction);
+  const TimingSummary critical_ms = critical.Summarize(), cpu_ms = cpu.Summarize();
+  state.counters["critical_median_ms"] = critical_ms.median;
+  state.counters["critical_mean_ms"] = critical_ms.mean;
+  state.counters["cpu_median_ms"] = cpu_ms.median;
+  state.counters["cpu_mean_ms"] = cpu_ms.mean;
+  state.counters["extraction_median_ms"] = extraction.Summarize().median;
 }
 BENCHMARK(BM_MarkerHandlingPerFrame)
     ->Arg(1)
