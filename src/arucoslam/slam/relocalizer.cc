@@ -202,18 +202,24 @@ std::vector<KeyframeId> Relocalizer::Candidates(const BowVector& bow, int* num_m
   return candidates;
 }
 
+std::optional<ImageWords> Relocalizer::QueryWords(const Frame& frame,
+                                                  RelocalizationStats* stats) const {
+  *stats = {};
+  if (frame.features.empty() || frame.features.undistorted.size() != frame.features.size()) {
+    return std::nullopt;
+  }
+  return database_.Transform(frame.features.descriptors);
+}
+
 std::optional<RelocalizationResult> Relocalizer::Relocalize(const Frame& frame,
                                                             RelocalizationStats* stats) const {
   RelocalizationStats local_stats;
   RelocalizationStats& s = stats != nullptr ? *stats : local_stats;
-  s = {};
-  if (frame.features.empty() || frame.features.undistorted.size() != frame.features.size()) {
-    return std::nullopt;
-  }
-  const ImageWords words = database_.Transform(frame.features.descriptors);
-  for (const KeyframeId& candidate : Candidates(words.bow, &s.num_database_matches)) {
+  const std::optional<ImageWords> words = QueryWords(frame, &s);
+  if (!words) return std::nullopt;
+  for (const KeyframeId& candidate : Candidates(words->bow, &s.num_database_matches)) {
     ++s.num_candidates;
-    std::optional<RelocalizationResult> result = Verify(frame, words.direct, candidate, &s);
+    std::optional<RelocalizationResult> result = Verify(frame, words->direct, candidate, &s);
     if (result) return result;
   }
   return std::nullopt;
@@ -224,11 +230,8 @@ std::optional<RelocalizationResult> Relocalizer::RelocalizeAt(
     RelocalizationStats* stats) const {
   RelocalizationStats local_stats;
   RelocalizationStats& s = stats != nullptr ? *stats : local_stats;
-  s = {};
-  if (frame.features.empty() || frame.features.undistorted.size() != frame.features.size()) {
-    return std::nullopt;
-  }
-  const ImageWords words = database_.Transform(frame.features.descriptors);
+  const std::optional<ImageWords> words = QueryWords(frame, &s);
+  if (!words) return std::nullopt;
   for (const KeyframeId& candidate : candidates) {
     std::optional<FeatureVector> own;
     if (database_.Direct(candidate) == nullptr) {
@@ -241,7 +244,7 @@ std::optional<RelocalizationResult> Relocalizer::RelocalizeAt(
     }
     ++s.num_candidates;
     std::optional<RelocalizationResult> result =
-        Verify(frame, words.direct, candidate, &s, own ? &*own : nullptr);
+        Verify(frame, words->direct, candidate, &s, own ? &*own : nullptr);
     if (result) return result;
   }
   return std::nullopt;

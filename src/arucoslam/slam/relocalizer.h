@@ -81,6 +81,9 @@ class Relocalizer {
   std::vector<KeyframeId> Candidates(const BowVector& bow, int* num_matches = nullptr) const;
 
  private:
+  // Resets `stats`; the frame's words, or nullopt when its features are missing or lack
+  // undistorted positions.
+  std::optional<ImageWords> QueryWords(const Frame& frame, RelocalizationStats* stats) const;
   // `keyframe_direct`: the candidate's words when the database does not hold them.
   std::optional<RelocalizationResult> Verify(const Frame& frame, const FeatureVector& direct,
                                              KeyframeId candidate, RelocalizationStats* stats,
