@@ -34,13 +34,7 @@ void BM_PoseGraphLoop(benchmark::State& state) {
 BENCHMARK(BM_PoseGraphLoop)->Arg(40)->Arg(200)->Arg(1000)->Unit(benchmark::kMillisecond);
 
 CameraModel BenchCamera() {
-  CameraModel camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 500.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
-  return camera;
+  return PinholeCamera(640, 480, 500.0);
 }
 
 std::vector<Sim3Correspondence> MakeMatches(const Sim3& candidate_from_current, int count) {

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "arucoslam/sim/dataset_writer.h"
+#include "arucoslam/sim/default_camera.h"
 #include "arucoslam/sim/factory_world.h"
 #include "arucoslam/sim/path.h"
 #include "arucoslam/sim/renderer.h"
@@ -17,17 +18,6 @@ namespace arucoslam {
 namespace {
 
 namespace fs = std::filesystem;
-
-CameraModel BenchCamera() {
-  CameraModel camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 460.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
-  camera.rate_hz = 30.0;
-  return camera;
-}
 
 // The default factory written once to a temporary folder, with its repeat-run poses.
 struct BenchWorld {
@@ -68,7 +58,7 @@ void BM_RenderFrame(benchmark::State& state) {
   RenderOptions options;
   options.msaa_samples = static_cast<int>(state.range(0));
   options.noise_sigma = 2.0;
-  Renderer renderer(bench.world, BenchCamera(), options);
+  Renderer renderer(bench.world, DefaultSimulatorCamera(), options);
   std::size_t i = 0;
   for (auto _ : state) {
     const RenderedFrame frame = renderer.Render(bench.View(i), i);
@@ -93,7 +83,7 @@ void BM_RenderAndEncodePng(benchmark::State& state) {
   RenderOptions options;
   options.msaa_samples = static_cast<int>(state.range(0));
   options.noise_sigma = 2.0;
-  Renderer renderer(bench.world, BenchCamera(), options);
+  Renderer renderer(bench.world, DefaultSimulatorCamera(), options);
   std::size_t i = 0;
   std::vector<uchar> png;
   for (auto _ : state) {
@@ -123,7 +113,7 @@ void BM_WriteSequence(benchmark::State& state) {
   options.render.msaa_samples = static_cast<int>(state.range(0));
   options.progress = false;
   for (auto _ : state) {
-    WriteSimulatedSequence(bench.dir / "world.sdf", BenchCamera(), poses, bench.dir / "seq",
+    WriteSimulatedSequence(bench.dir / "world.sdf", DefaultSimulatorCamera(), poses, bench.dir / "seq",
                            options);
   }
   state.counters["frames/s"] = benchmark::Counter(

@@ -36,12 +36,7 @@ void ReportStats(benchmark::State& state, const SystemStats& stats, double wall_
 // 120 frames of synthetic features (about 1000 keypoints each, 640x480, 20 Hz) along a
 // sideways path; tracking and mapping only (no image processing).
 void BM_BlockingSyntheticRun(benchmark::State& state) {
-  CameraModel camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 500.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
+  const CameraModel camera = PinholeCamera(640, 480, 500.0);
   SyntheticFeatureOptions scene_options;
   scene_options.num_points = 2000;
   for (auto _ : state) {

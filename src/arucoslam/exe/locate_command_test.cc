@@ -40,13 +40,7 @@ class LocateCommandTest : public ::testing::Test {
   }
 
   static CameraModel Camera() {
-    CameraModel camera;
-    camera.width = 640;
-    camera.height = 480;
-    camera.fx = camera.fy = 500.0;
-    camera.cx = 319.5;
-    camera.cy = 239.5;
-    return camera;
+    return PinholeCamera(640, 480, 500.0);
   }
 
   // Two 0.2 m markers (ids 3 and 8) on a wall 2 m ahead of a camera at a known world pose;

@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "arucoslam/geometry/camera.h"
 #include "arucoslam/io/calibration.h"
 #include "arucoslam/io/marker_map_json.h"
 #include "arucoslam/io/trajectory_io.h"
@@ -95,12 +96,7 @@ fs::path MakePlaneSequence(const fs::path& dir, int num_frames) {
     if (first.empty() || entry.path() < first) first = entry.path();
   }
   const cv::Mat texture = cv::imread(first.string(), cv::IMREAD_GRAYSCALE);
-  CameraModel camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 450.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
+  const CameraModel camera = PinholeCamera(640, 480, 450.0);
   const fs::path images = dir / "images";
   fs::create_directories(images);
   WriteEuRoCSensorYaml(camera, dir / "camera.yaml");

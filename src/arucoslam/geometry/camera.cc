@@ -177,6 +177,16 @@ Eigen::Matrix<double, 2, 3> CameraModel::ProjectJacobian(const Eigen::Vector3d& 
   return pixel_d_distorted * distorted_d_normalised * normalised_d_point;
 }
 
+CameraModel PinholeCamera(int width, int height, double focal_px) {
+  CameraModel camera;
+  camera.width = width;
+  camera.height = height;
+  camera.fx = camera.fy = focal_px;
+  camera.cx = 0.5 * (width - 1);
+  camera.cy = 0.5 * (height - 1);
+  return camera;
+}
+
 std::string DistortionModelName(DistortionModel model) {
   switch (model) {
     case DistortionModel::kNone:

@@ -42,4 +42,8 @@ struct CameraModel {
 
 std::string DistortionModelName(DistortionModel model);
 
+// A distortion-free camera of `width` x `height` pixels with focal length `focal_px` (fx = fy)
+// and the principal point at the image centre ((width - 1) / 2, (height - 1) / 2).
+CameraModel PinholeCamera(int width, int height, double focal_px);
+
 }  // namespace arucoslam

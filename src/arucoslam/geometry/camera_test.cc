@@ -249,5 +249,20 @@ TEST(CameraModelTest, InImageUsesPixelCentresAndBorder) {
   EXPECT_FALSE(camera.InImage(Eigen::Vector2d(5.0, 5.0), 10.0));
 }
 
+TEST(CameraModelTest, PinholeCameraCentresThePrincipalPoint) {
+  const CameraModel camera = PinholeCamera(640, 480, 500.0);
+  EXPECT_TRUE(camera.Check());
+  EXPECT_EQ(camera.model, DistortionModel::kNone);
+  EXPECT_DOUBLE_EQ(camera.fx, 500.0);
+  EXPECT_DOUBLE_EQ(camera.fy, 500.0);
+  EXPECT_DOUBLE_EQ(camera.cx, 319.5);
+  EXPECT_DOUBLE_EQ(camera.cy, 239.5);
+  // A point on the optical axis projects to the image centre.
+  const auto pixel = camera.Project(Eigen::Vector3d(0.0, 0.0, 2.0));
+  ASSERT_TRUE(pixel);
+  EXPECT_DOUBLE_EQ(pixel->x(), 319.5);
+  EXPECT_DOUBLE_EQ(pixel->y(), 239.5);
+}
+
 }  // namespace
 }  // namespace arucoslam

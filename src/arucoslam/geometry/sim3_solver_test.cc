@@ -4,17 +4,13 @@
 
 #include <random>
 
+#include "arucoslam/geometry/camera.h"
+
 namespace arucoslam {
 namespace {
 
 CameraModel MakeCamera() {
-  CameraModel camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 500.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
-  return camera;
+  return PinholeCamera(640, 480, 500.0);
 }
 
 Eigen::Vector2d Project(const CameraModel& camera, const Eigen::Vector3d& p) {

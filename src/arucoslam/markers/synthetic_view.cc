@@ -166,13 +166,7 @@ cv::Mat RenderSyntheticView(const CameraModel& camera, const std::vector<Synthet
 }
 
 CameraModel SyntheticCamera640() {
-  CameraModel camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 500.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
-  return camera;
+  return PinholeCamera(640, 480, 500.0);
 }
 
 }  // namespace arucoslam

@@ -28,11 +28,7 @@ struct LoopMap {
 
 Keyframe MakeKeyframe(const Rigid3& cam_from_world, int num_keypoints) {
   Keyframe keyframe;
-  keyframe.camera.width = 640;
-  keyframe.camera.height = 480;
-  keyframe.camera.fx = keyframe.camera.fy = 500.0;
-  keyframe.camera.cx = 319.5;
-  keyframe.camera.cy = 239.5;
+  keyframe.camera = PinholeCamera(640, 480, 500.0);
   keyframe.cam_from_world = cam_from_world;
   keyframe.features.pyramid = ScalePyramid::Make(8, 1.2);
   for (int i = 0; i < num_keypoints; ++i) {

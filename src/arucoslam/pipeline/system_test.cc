@@ -14,13 +14,7 @@ namespace arucoslam {
 namespace {
 
 CameraModel TestCamera() {
-  CameraModel camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 500.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
-  return camera;
+  return PinholeCamera(640, 480, 500.0);
 }
 
 // A sideways, slightly weaving and turning camera path (20 Hz); `moving` false holds it still.

@@ -17,13 +17,7 @@ namespace arucoslam::test_scene {
 inline constexpr double kSceneDt = 0.05;  // 20 Hz
 
 inline CameraModel SceneCamera() {
-  CameraModel camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 500.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
-  return camera;
+  return PinholeCamera(640, 480, 500.0);
 }
 
 // Sideways (0.6 m/s), weaving, slowly turning camera, metres.

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "arucoslam/geometry/camera.h"
+
 namespace arucoslam {
 namespace {
 
@@ -87,12 +89,7 @@ TEST(KeyframePolicy, WeakKeyframesAreSpaced) {
 
 TEST(KeyframePolicy, InsertKeyframeLinksCovisibilityAndSpanningTree) {
   Map map;
-  CameraModel camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 500.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
+  const CameraModel camera = PinholeCamera(640, 480, 500.0);
   Frame frame;
   frame.camera = camera;
   frame.features.keypoints.resize(10);

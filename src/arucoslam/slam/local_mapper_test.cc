@@ -32,13 +32,7 @@ class Scene {
 
  private:
   static CameraModel TestCamera() {
-    CameraModel camera;
-    camera.width = 640;
-    camera.height = 480;
-    camera.fx = camera.fy = 500.0;
-    camera.cx = 319.5;
-    camera.cy = 239.5;
-    return camera;
+    return PinholeCamera(640, 480, 500.0);
   }
   static SyntheticFeatureOptions MakeOptions(std::uint32_t seed) {
     SyntheticFeatureOptions options;

@@ -11,13 +11,7 @@ namespace {
 using Descriptor = std::array<std::uint8_t, kOrbDescriptorBytes>;
 
 CameraModel LoopCamera() {
-  CameraModel camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 500.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
-  return camera;
+  return PinholeCamera(640, 480, 500.0);
 }
 
 struct Wall {

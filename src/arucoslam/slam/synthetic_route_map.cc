@@ -38,13 +38,7 @@ SyntheticRoute::SyntheticRoute(const SyntheticRouteOptions& options)
 }
 
 CameraModel SyntheticRoute::Camera() {
-  CameraModel camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 500.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
-  return camera;
+  return PinholeCamera(640, 480, 500.0);
 }
 
 Rigid3 SyntheticRoute::CamFromWorld(double azimuth_deg, double yaw_deg, double radial_m) const {

@@ -7,17 +7,13 @@
 #include <algorithm>
 #include <random>
 
+#include "arucoslam/geometry/camera.h"
+
 namespace arucoslam {
 namespace {
 
 CameraModel TestCamera() {
-  CameraModel camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 500.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
-  return camera;
+  return PinholeCamera(640, 480, 500.0);
 }
 
 // Points with random descriptors in front of a camera moving along world x with a slow yaw;
