@@ -17,6 +17,22 @@
 namespace arucoslam {
 namespace {
 
+// Adds, per detection, the distances of its four corners to the projected corners of the
+// marker with its id (SyntheticCamera640) to `error_sum`, and 4 to `corners`. A detection
+// whose id is not among `markers` fails the test.
+void AddCornerErrors(const std::vector<MarkerDetection>& detections,
+                     const std::vector<SyntheticMarker>& markers, double* error_sum,
+                     int* corners) {
+  for (const MarkerDetection& d : detections) {
+    const auto marker = std::find_if(markers.begin(), markers.end(),
+                                     [&](const SyntheticMarker& m) { return m.id == d.id; });
+    ASSERT_NE(marker, markers.end()) << "no marker " << d.id << " in the image";
+    const std::array<Eigen::Vector2d, 4> truth = ProjectMarkerCorners(SyntheticCamera640(), *marker);
+    for (int k = 0; k < 4; ++k) *error_sum += (d.corners[k] - truth[k]).norm();
+    *corners += 4;
+  }
+}
+
 // A marker at `depth` metres, tilted by `tilt` radians about a random axis across the
 // view, rolled randomly about its normal, placed randomly but wholly inside the image.
 SyntheticMarker RandomMarker(double depth, double tilt, std::mt19937& rng) {
@@ -315,21 +331,13 @@ TEST(MarkerDetectorTest, ThresholdLineFitCornersOnRenderedMarkers) {
       SyntheticViewOptions view;
       view.seed = 60 + image_index;
       view.blur_sigma_px = 0.6 + 0.2 * image_index;
-      std::vector<uchar> jpeg;
-      cv::imencode(".jpg", RenderSyntheticView(SyntheticCamera640(), markers, view), jpeg,
-                   {cv::IMWRITE_JPEG_QUALITY, 85});
-      const cv::Mat image = cv::imdecode(jpeg, cv::IMREAD_GRAYSCALE);
+      const cv::Mat image =
+          ThroughJpeg(RenderSyntheticView(SyntheticCamera640(), markers, view), 85);
       for (int variant = 0; variant < variants; ++variant) {
         options.threshold_line_fit = variant == 1;
         options.april_tag_quad_corners = variant == 2;
-        for (const MarkerDetection& d : MarkerDetector(options).Detect(image)) {
-          const auto marker = std::find_if(markers.begin(), markers.end(),
-                                           [&](const SyntheticMarker& m) { return m.id == d.id; });
-          ASSERT_NE(marker, markers.end()) << "no marker " << d.id << " in the image";
-          const std::array<Eigen::Vector2d, 4> truth = ProjectMarkerCorners(SyntheticCamera640(), *marker);
-          for (int k = 0; k < 4; ++k) error_sum[variant] += (d.corners[k] - truth[k]).norm();
-          corners[variant] += 4;
-        }
+        AddCornerErrors(MarkerDetector(options).Detect(image), markers, &error_sum[variant],
+                        &corners[variant]);
       }
     }
     std::printf("%s: %d corners, mean error %.3f px without the threshold line fit, %.3f with\n",
@@ -379,20 +387,11 @@ TEST(MarkerDetectorTest, AprilTagQuadCornersOnRenderedMarkers) {
     SyntheticViewOptions view;
     view.seed = 10 + image_index;
     view.blur_sigma_px = 0.6 + 0.1 * image_index;
-    std::vector<uchar> jpeg;
-    cv::imencode(".jpg", RenderSyntheticView(SyntheticCamera640(), markers, view), jpeg,
-                 {cv::IMWRITE_JPEG_QUALITY, 90});
-    const cv::Mat image = cv::imdecode(jpeg, cv::IMREAD_GRAYSCALE);
+    const cv::Mat image = ThroughJpeg(RenderSyntheticView(SyntheticCamera640(), markers, view), 90);
     for (const bool quad_corners : {false, true}) {
       options.april_tag_quad_corners = quad_corners;
-      for (const MarkerDetection& d : MarkerDetector(options).Detect(image)) {
-        const auto marker = std::find_if(markers.begin(), markers.end(),
-                                         [&](const SyntheticMarker& m) { return m.id == d.id; });
-        ASSERT_NE(marker, markers.end()) << "no marker " << d.id << " in the image";
-        const std::array<Eigen::Vector2d, 4> truth = ProjectMarkerCorners(SyntheticCamera640(), *marker);
-        for (int k = 0; k < 4; ++k) error_sum[quad_corners] += (d.corners[k] - truth[k]).norm();
-        corners[quad_corners] += 4;
-      }
+      AddCornerErrors(MarkerDetector(options).Detect(image), markers, &error_sum[quad_corners],
+                      &corners[quad_corners]);
     }
   }
   std::printf(

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
@@ -163,6 +164,12 @@ cv::Mat RenderSyntheticView(const CameraModel& camera, const std::vector<Synthet
   cv::Mat result;
   image.convertTo(result, CV_8U);  // rounds and saturates to 0..255
   return result;
+}
+
+cv::Mat ThroughJpeg(const cv::Mat& image, int quality) {
+  std::vector<uchar> bytes;
+  cv::imencode(".jpg", image, bytes, {cv::IMWRITE_JPEG_QUALITY, quality});
+  return cv::imdecode(bytes, cv::IMREAD_GRAYSCALE);
 }
 
 CameraModel SyntheticCamera640() {

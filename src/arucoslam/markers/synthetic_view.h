@@ -48,6 +48,10 @@ CameraModel SyntheticCamera640();
 cv::Mat RenderSyntheticView(const CameraModel& camera, const std::vector<SyntheticMarker>& markers,
                             const SyntheticViewOptions& options = {});
 
+// `image` compressed as JPEG at `quality` (0-100) and decoded to grey: the blocking and ringing
+// of a camera's compression.
+cv::Mat ThroughJpeg(const cv::Mat& image, int quality);
+
 // The true pixel positions of a marker's black-square corners (OpenCV order), pinhole.
 std::array<Eigen::Vector2d, 4> ProjectMarkerCorners(const CameraModel& camera,
                                                     const SyntheticMarker& marker);

@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <opencv2/imgcodecs.hpp>
 #include <random>
 #include <vector>
 
@@ -12,12 +11,6 @@
 
 namespace arucoslam {
 namespace {
-
-cv::Mat ThroughJpeg(const cv::Mat& image, int quality) {
-  std::vector<uchar> bytes;
-  cv::imencode(".jpg", image, bytes, {cv::IMWRITE_JPEG_QUALITY, quality});
-  return cv::imdecode(bytes, cv::IMREAD_GRAYSCALE);
-}
 
 std::array<cv::Point2f, 4> ToPoints(const std::array<Eigen::Vector2d, 4>& corners) {
   std::array<cv::Point2f, 4> points;
