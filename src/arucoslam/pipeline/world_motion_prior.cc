@@ -16,8 +16,8 @@ std::optional<Rigid3> WorldMotionPrior::Predict(double timestamp_s) const {
   const Fix& oldest = fixes_.front();  // within max_span_s of the newest (Add)
   const double span = newest.timestamp_s - oldest.timestamp_s;
   if (span < options_.min_span_s) return std::nullopt;
-  const Rigid3 motion = oldest.world_from_cam.Inverse() * newest.world_from_cam;
-  const Eigen::Vector3d omega = LogSO3(motion.rotation) / span;
+  const Eigen::Vector3d omega =
+      LogSO3(oldest.world_from_cam.rotation.conjugate() * newest.world_from_cam.rotation) / span;
   // Rotation and position extrapolated separately: the camera centre moves at the world
   // velocity between the fixes, the orientation turns at their relative angular rate.
   const Eigen::Vector3d velocity =
