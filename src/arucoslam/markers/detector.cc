@@ -137,7 +137,7 @@ cv::Mat GreyImage(const cv::Mat& image) {
 std::vector<MarkerDetection> MarkerDetector::Detect(const cv::Mat& image) const {
   if (image.empty()) return {};
   const cv::Mat gray = GreyImage(image);
-  return RemoveDuplicateDetections(DetectInGray(gray, *parameters_, 1.0),
+  return RemoveDuplicateDetections(DetectInGray(gray, *parameters_),
                                    options_.dedup_distance_rate);
 }
 
@@ -156,7 +156,7 @@ std::vector<MarkerDetection> MarkerDetector::DetectInRegions(
     cv::aruco::DetectorParameters parameters = *parameters_;
     parameters.minMarkerPerimeterRate *= perimeter_scale;
     parameters.maxMarkerPerimeterRate *= perimeter_scale;
-    for (MarkerDetection& detection : DetectInGray(gray(part), parameters, perimeter_scale)) {
+    for (MarkerDetection& detection : DetectInGray(gray(part), parameters)) {
       for (Eigen::Vector2d& corner : detection.corners) corner += Eigen::Vector2d(part.x, part.y);
       detections.push_back(detection);
     }
@@ -165,8 +165,7 @@ std::vector<MarkerDetection> MarkerDetector::DetectInRegions(
 }
 
 std::vector<MarkerDetection> MarkerDetector::DetectInGray(
-    const cv::Mat& gray, const cv::aruco::DetectorParameters& parameters,
-    double perimeter_scale) const {
+    const cv::Mat& gray, const cv::aruco::DetectorParameters& parameters) const {
   const double scale = options_.upsample;
   cv::Mat work = gray;
   if (scale > 1.0) cv::resize(gray, work, cv::Size(), scale, scale, cv::INTER_LINEAR);
@@ -228,10 +227,8 @@ std::vector<MarkerDetection> MarkerDetector::DetectInGray(
         options_.rescue_contour_candidates) {
       std::vector<std::vector<cv::Point2f>> contour_corners, contour_rejected;
       std::vector<int> contour_ids;
-      cv::Ptr<cv::aruco::DetectorParameters> contour_parameters = options_.ToOpenCv();
+      const auto contour_parameters = cv::makePtr<cv::aruco::DetectorParameters>(parameters);
       contour_parameters->cornerRefinementMethod = cv::aruco::CORNER_REFINE_NONE;
-      contour_parameters->minMarkerPerimeterRate *= perimeter_scale;
-      contour_parameters->maxMarkerPerimeterRate *= perimeter_scale;
       cv::aruco::detectMarkers(work, dictionary_, contour_corners, contour_ids, contour_parameters,
                                contour_rejected);
       rescue_candidates(contour_corners);

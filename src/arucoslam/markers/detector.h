@@ -142,11 +142,10 @@ class MarkerDetector {
 
  private:
   void RefineSubpix(const cv::Mat& gray, std::vector<cv::Point2f>& corners) const;
-  // Detections in `gray` (the whole image or a part of it; `perimeter_scale` is what the
-  // part multiplies the perimeter rates by), duplicates not yet removed.
+  // Detections in `gray` (the whole image or a part of it, with `parameters` whose perimeter
+  // rates are scaled for that part), duplicates not yet removed.
   std::vector<MarkerDetection> DetectInGray(const cv::Mat& gray,
-                                            const cv::aruco::DetectorParameters& parameters,
-                                            double perimeter_scale) const;
+                                            const cv::aruco::DetectorParameters& parameters) const;
 
   DetectorOptions options_;
   cv::Ptr<cv::aruco::Dictionary> dictionary_;
