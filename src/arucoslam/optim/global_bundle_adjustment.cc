@@ -44,7 +44,8 @@ int EraseOutliers(MapData& data, const GlobalBundleAdjustmentSnapshot& snapshot,
 }  // namespace
 
 GlobalBundleAdjustmentSnapshot TakeGlobalSnapshot(const MapData& data,
-                                                  const GlobalBundleAdjustmentOptions& options) {
+                                                  const GlobalBundleAdjustmentOptions& options,
+                                                  const MarkerLandmarks* landmarks) {
   GlobalBundleAdjustmentSnapshot snapshot;
   std::map<KeyframeId, std::size_t> pose_index;
   for (const auto& [id, keyframe] : data.keyframes()) {
@@ -70,12 +71,28 @@ GlobalBundleAdjustmentSnapshot TakeGlobalSnapshot(const MapData& data,
       snapshot.keypoint_indices.push_back(index);
     }
   }
+  if (landmarks != nullptr) {
+    snapshot.markers =
+        CollectMarkerFactors(data, snapshot.keyframe_ids, *landmarks, options.markers);
+    if (snapshot.markers.num_fixed_markers > 0) {
+      for (auto& pose : snapshot.problem.poses) pose.fixed = false;
+    }
+  }
   return snapshot;
+}
+
+BundleAdjustmentSummary SolveGlobalSnapshot(const GlobalBundleAdjustmentOptions& options,
+                                            GlobalBundleAdjustmentSnapshot* snapshot) {
+  return SolveBundleAdjustmentWithMarkers(options.solver, options.markers, &snapshot->markers,
+                                          &snapshot->problem);
 }
 
 void ApplyGlobalBundleAdjustment(MapData& data, const GlobalBundleAdjustmentSnapshot& snapshot,
                                  const GlobalBundleAdjustmentOptions& options,
-                                 GlobalBundleAdjustmentResult* result) {
+                                 GlobalBundleAdjustmentResult* result,
+                                 MarkerLandmarks* landmarks) {
+  result->num_marker_observations = static_cast<int>(snapshot.markers.observations.size());
+  if (landmarks != nullptr) ApplyMarkerFactors(snapshot.markers, landmarks);
   std::map<KeyframeId, std::size_t> pose_index;
   for (std::size_t i = 0; i < snapshot.keyframe_ids.size(); ++i) {
     pose_index[snapshot.keyframe_ids[i]] = i;
@@ -129,23 +146,25 @@ void ApplyGlobalBundleAdjustment(MapData& data, const GlobalBundleAdjustmentSnap
 }
 
 GlobalBundleAdjustmentResult RunGlobalBundleAdjustment(
-    Map& map, const GlobalBundleAdjustmentOptions& options) {
+    Map& map, const GlobalBundleAdjustmentOptions& options, MarkerLandmarks* landmarks) {
   GlobalBundleAdjustmentResult result;
   if (!options.Check()) {
     result.summary.message = "invalid options";
     return result;
   }
   GlobalBundleAdjustmentSnapshot snapshot =
-      map.Read([&](const MapData& data) { return TakeGlobalSnapshot(data, options); });
+      map.Read([&](const MapData& data) { return TakeGlobalSnapshot(data, options, landmarks); });
   result.num_keyframes = static_cast<int>(snapshot.keyframe_ids.size());
   result.num_points = static_cast<int>(snapshot.point_ids.size());
   if (snapshot.problem.observations.empty()) {
     result.summary.message = "no observations";
     return result;
   }
-  result.summary = SolveBundleAdjustment(options.solver, &snapshot.problem);
+  result.summary = SolveGlobalSnapshot(options, &snapshot);
   if (!result.summary.success) return result;
-  map.Write([&](MapData& data) { ApplyGlobalBundleAdjustment(data, snapshot, options, &result); });
+  map.Write([&](MapData& data) {
+    ApplyGlobalBundleAdjustment(data, snapshot, options, &result, landmarks);
+  });
   result.applied = true;
   return result;
 }

@@ -1,11 +1,14 @@
-// Global bundle adjustment of every keyframe and point of a Map in three steps that let it run
-// in the background: snapshot (read lock), solve (no lock), apply with corrections (write lock).
+// Global bundle adjustment of every keyframe and point of a Map (and, once it is in the marker
+// world, of every marker-corner view) in three steps that let it run in the background:
+// snapshot (read lock), solve (no lock), apply with corrections (write lock).
 #pragma once
 
 #include <vector>
 
 #include "arucoslam/map/map.h"
+#include "arucoslam/map/marker_landmark.h"
 #include "arucoslam/optim/bundle_adjustment.h"
+#include "arucoslam/optim/marker_factors.h"
 
 namespace arucoslam {
 
@@ -17,8 +20,11 @@ struct GlobalBundleAdjustmentOptions {
   int num_fixed_keyframes = 2;
   // Erase observations the solve flags as outliers; points left with none are erased.
   bool erase_outliers = true;
+  // Marker-corner residuals (when marker landmarks are given). A known (fixed) marker in view
+  // holds position, orientation and scale: no keyframe is fixed then.
+  MarkerFactorOptions markers;
 
-  bool Check() const { return solver.Check() && num_fixed_keyframes >= 1; }
+  bool Check() const { return solver.Check() && num_fixed_keyframes >= 1 && markers.Check(); }
 };
 
 // The whole map as a BundleAdjustmentProblem plus the ids behind its indices and the poses
@@ -29,6 +35,7 @@ struct GlobalBundleAdjustmentSnapshot {
   std::vector<Rigid3> poses_before;      // per problem pose
   std::vector<MapPointId> point_ids;     // per problem point
   std::vector<int> keypoint_indices;     // per observation
+  MarkerFactors markers;                 // the keyframes' marker views (none without landmarks)
 };
 
 struct GlobalBundleAdjustmentResult {
@@ -38,24 +45,35 @@ struct GlobalBundleAdjustmentResult {
   int num_erased_observations = 0;
   int num_corrected_keyframes = 0;  // added after the snapshot, moved with their tree ancestor
   int num_corrected_points = 0;     // idem, moved with their reference keyframe
+  int num_marker_observations = 0;  // marker-corner residual blocks (8-vectors)
   BundleAdjustmentSummary summary;
 };
 
+// With `landmarks`, every keyframe's views of them join the problem (read the landmarks
+// while nothing edits them).
 GlobalBundleAdjustmentSnapshot TakeGlobalSnapshot(const MapData& data,
-                                                  const GlobalBundleAdjustmentOptions& options);
+                                                  const GlobalBundleAdjustmentOptions& options,
+                                                  const MarkerLandmarks* landmarks = nullptr);
+
+// Solves the snapshot in place (keypoints, and marker corners when it has marker factors).
+BundleAdjustmentSummary SolveGlobalSnapshot(const GlobalBundleAdjustmentOptions& options,
+                                            GlobalBundleAdjustmentSnapshot* snapshot);
 
 // Writes a solved snapshot back: solved keyframes and points take their new values (even if
 // the map moved them since; stop other optimisers meanwhile); keyframes that are not in the
 // snapshot follow their nearest spanning-tree ancestor that is (world correction
 // T_before^-1 * T_after), points that are not follow their reference keyframe. Entities erased
-// since are skipped. Fills the counters of `result`.
+// since are skipped. Solved mapped markers are written to `landmarks` when given. Fills the
+// counters of `result`.
 void ApplyGlobalBundleAdjustment(MapData& data, const GlobalBundleAdjustmentSnapshot& snapshot,
                                  const GlobalBundleAdjustmentOptions& options,
-                                 GlobalBundleAdjustmentResult* result);
+                                 GlobalBundleAdjustmentResult* result,
+                                 MarkerLandmarks* landmarks = nullptr);
 
 // Snapshot, solve and apply in one call (blocking; run it on a worker thread to keep
 // tracking going: the map's lock is held only for the snapshot and the write-back).
 GlobalBundleAdjustmentResult RunGlobalBundleAdjustment(
-    Map& map, const GlobalBundleAdjustmentOptions& options = {});
+    Map& map, const GlobalBundleAdjustmentOptions& options = {},
+    MarkerLandmarks* landmarks = nullptr);
 
 }  // namespace arucoslam

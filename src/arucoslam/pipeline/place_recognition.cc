@@ -241,30 +241,33 @@ void PlaceRecognition::RunGlobalBundleAdjustmentOnce() {
   {
     std::unique_lock edit = LockMapEdits();
     epoch = epoch_;
-    snapshot =
-        map_.Read([&](const MapData& data) { return TakeGlobalSnapshot(data, options_.global_ba); });
+    snapshot = map_.Read([&](const MapData& data) {
+      return TakeGlobalSnapshot(data, options_.global_ba, marker_landmarks_);
+    });
   }
   if (snapshot.problem.observations.empty()) return;
   GlobalBundleAdjustmentResult result;
   result.num_keyframes = static_cast<int>(snapshot.keyframe_ids.size());
   result.num_points = static_cast<int>(snapshot.point_ids.size());
   // Tracking and local mapping go on while the solver runs (no lock held).
-  result.summary = SolveBundleAdjustment(options_.global_ba.solver, &snapshot.problem);
+  result.summary = SolveGlobalSnapshot(options_.global_ba, &snapshot);
   bool applied = false;
   if (result.summary.success) {
     std::unique_lock edit = LockMapEdits();
     if (epoch == epoch_) {
       map_.Write([&](MapData& data) {
-        ApplyGlobalBundleAdjustment(data, snapshot, options_.global_ba, &result);
+        ApplyGlobalBundleAdjustment(data, snapshot, options_.global_ba, &result,
+                                    marker_landmarks_);
       });
       applied = true;
       ++corrections_;
     }
   }
   const double elapsed = watch.ElapsedMilliseconds();
-  ARUCOSLAM_LOG_INFO("global BA {}: {} keyframes, {} points, rms {:.2f} -> {:.2f} px, "
-                     "{} keyframes and {} points added meanwhile, {:.0f} ms",
+  ARUCOSLAM_LOG_INFO("global BA {}: {} keyframes, {} points, {} marker views, rms {:.2f} -> "
+                     "{:.2f} px, {} keyframes and {} points added meanwhile, {:.0f} ms",
                      applied ? "applied" : "discarded", result.num_keyframes, result.num_points,
+                     snapshot.markers.observations.size(),
                      result.summary.initial_rms_px, result.summary.final_rms_px,
                      result.num_corrected_keyframes, result.num_corrected_points, elapsed);
   std::lock_guard lock(*stats_mutex_);

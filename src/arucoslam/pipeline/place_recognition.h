@@ -94,6 +94,10 @@ class PlaceRecognition {
   void MapMovedExternally();
   // The loop closer keeps the monocular scale fixed once the map is metric (markers).
   void SetMetricMap(bool metric);
+  // Once the map is in the marker world: the markers whose corner views join global BA (known
+  // ones fixed, mapped ones estimated). Call it holding LockMapEdits; the landmarks are read
+  // and written only under that lock. Null: keypoints only.
+  void SetMarkerLandmarks(MarkerLandmarks* landmarks) { marker_landmarks_ = landmarks; }
   // Incremented by each closed loop and applied global BA: the tracking thread re-anchors
   // its last pose to its reference keyframe when this changes.
   std::uint64_t corrections() const { return corrections_; }
@@ -127,6 +131,7 @@ class PlaceRecognition {
   Relocalizer relocalizer_;
   LoopDetector detector_;
   LoopCloser closer_;
+  MarkerLandmarks* marker_landmarks_ = nullptr;  // guarded by edit_mutex_
 
   std::mutex edit_mutex_;
   std::uint64_t epoch_ = 0;  // under edit_mutex_: bumped by every change a global BA cannot merge

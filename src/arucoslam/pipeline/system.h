@@ -117,10 +117,12 @@ struct SystemOptions {
   // markers fixed) and markers the map lacks are mapped (system_marker_mapping.cc).
   bool markers_in_local_ba = true;
   bool map_unknown_markers = true;
-  // When markers were mapped, Finish runs one bundle adjustment of the whole aligned map with
-  // every marker observation (known markers fixed); otherwise only the mapped markers are
-  // refined.
-  bool final_marker_bundle_adjustment = true;
+  // A world-aligned map gets one bundle adjustment of all its keyframes and points with every
+  // marker-corner observation (known markers fixed, mapped ones estimated, views of culled
+  // keyframes kept) when it is closed after a loss and at Finish. On the demo sequence this
+  // halves the monocular scale error (1.9% -> 0.9%) and the world ATE (0.40 -> 0.25 m) for
+  // about 1 s of solving. false: at Finish only the mapped markers are refined.
+  bool whole_map_marker_adjustment = true;
   // Mapped markers seen by at least this many keyframes locate frames like known ones
   // (marker poses and relocalisation where the known map has no marker). 0: never.
   int min_locating_marker_keyframes = 3;
@@ -219,6 +221,7 @@ struct SystemStats {
   int num_marker_initializations = 0;  // maps initialised from two marker locations
   int num_maps_discarded = 0;          // closed maps never aligned (marker map only)
   int num_marker_corrections = 0;      // pose-graph corrections of drift by markers
+  int num_whole_map_marker_adjustments = 0;  // bundle adjustments of a whole map with markers
 };
 
 struct StampedPose {
@@ -334,6 +337,9 @@ class System {
   void FeedMarkerMapping(KeyframeId keyframe);
   void ResetMarkerMapping();
   void FinishMarkerMapping();
+  // Bundle adjustment of the whole world-aligned map with every marker view (`when` is for
+  // the log); the mapping thread must be stopped.
+  void AdjustWholeMapWithMarkers(const char* when);
   void PublishLocatingMarkers();  // mapping thread, after a keyframe's markers were added
   // Mapping thread, after FeedMarkerMapping: the pose-graph correction when the keyframe's
   // markers contradict its pose (system_drift_correction.cc). True when the map moved.
@@ -341,12 +347,6 @@ class System {
   // The pose-graph prior of a keyframe from its marker location (standard deviations from
   // the marker_priors options).
   KeyframePosePrior MarkerPrior(KeyframeId keyframe, const MarkerFix& fix) const;
-  // The markers to add to a global BA (CollectMarkerFactors / ApplyMarkerFactors) or pose
-  // graph (MarkerPosePriors) of the current map; null before world alignment. Use it from
-  // the mapping thread or while it is stopped.
-  MarkerLandmarks* OptimisationMarkers() {
-    return marker_mapping_live_ ? marker_mapper_->mutable_landmarks() : nullptr;
-  }
   std::shared_ptr<const MarkerMap> LocatingMarkers() const;
   void MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& report);
   void MapKeyframe(KeyframeId keyframe);

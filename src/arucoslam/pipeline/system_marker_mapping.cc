@@ -1,6 +1,7 @@
 // System's marker mapping: once the keypoint map is in the marker world, every keyframe's
 // marker observations go to a MarkerMapper (known markers fixed, unknown ones mapped online),
-// whose landmarks join local bundle adjustment; at the end the mapped markers are refined.
+// whose landmarks join local bundle adjustment; a map is adjusted as a whole with every marker
+// view when it is closed and at the end of the run.
 #include <memory>
 #include <optional>
 #include <utility>
@@ -21,6 +22,8 @@ void System::StartMarkerMapping() {
   marker_mapping_live_ = true;
   if (options_.markers_in_local_ba) {
     mapper_->SetMarkerLandmarks(marker_mapper_->mutable_landmarks());
+    // The caller holds the places' edit lock (LockPlacesForMapMove).
+    if (places_) places_->SetMarkerLandmarks(marker_mapper_->mutable_landmarks());
   }
   // Keyframes mapped before the alignment are recorded now, at their aligned poses.
   const std::vector<KeyframeId> keyframes = map_->Read([&](const MapData& data) {
@@ -86,8 +89,26 @@ void System::ResetMarkerMapping() {
   marker_mapper_->CloseMap();
 }
 
+void System::AdjustWholeMapWithMarkers(const char* when) {
+  if (!marker_mapper_ || !marker_mapping_live_ || !options_.whole_map_marker_adjustment) return;
+  const MarkerBundleAdjustmentSummary summary = map_->Write([&](MapData& data) {
+    marker_mapper_->SyncKeyframes(data);
+    return marker_mapper_->Refine(&data);
+  });
+  ARUCOSLAM_LOG_DEBUG("bundle adjustment of the whole map with markers ({}, {} views of culled "
+                      "keyframes): {}",
+                      when, marker_mapper_->NumRetiredViews(), summary.BriefReport());
+  if (!summary.success) return;
+  std::lock_guard lock(stats_mutex_);
+  ++stats_.num_whole_map_marker_adjustments;
+}
+
 void System::FinishMarkerMapping() {
   if (!marker_mapper_) return;
+  if (marker_mapping_live_ && options_.whole_map_marker_adjustment) {
+    AdjustWholeMapWithMarkers("end of the run");
+    return;
+  }
   map_->Read([&](const MapData& data) {
     marker_mapper_->SyncKeyframes(data);
     return 0;
@@ -97,15 +118,6 @@ void System::FinishMarkerMapping() {
     if (!landmark.fixed) ++num_mapped;
   }
   if (num_mapped == 0) return;
-  // The whole-map bundle adjustment runs only when there are markers to map: with every
-  // marker known it made the synthetic wall run worse (10.1 mm RMS against 5.0 mm without).
-  if (marker_mapping_live_ && options_.final_marker_bundle_adjustment) {
-    const MarkerBundleAdjustmentSummary summary =
-        map_->Write([&](MapData& data) { return marker_mapper_->Refine(&data); });
-    ARUCOSLAM_LOG_DEBUG("final bundle adjustment with markers ({} views of culled keyframes): {}",
-                        marker_mapper_->NumRetiredViews(), summary.BriefReport());
-    return;
-  }
   const MarkerBundleAdjustmentSummary summary = marker_mapper_->RefineMarkers();
   ARUCOSLAM_LOG_DEBUG("{} mapped markers refined: {}", num_mapped, summary.BriefReport());
 }

@@ -92,6 +92,25 @@ double AlignmentScale(const std::vector<StampedPose>& trajectory) {
   return truth_from_estimate ? truth_from_estimate->scale : 0.0;
 }
 
+// World-frame RMSE of the frames the keypoint map posed and of those the markers alone posed
+// (before the map exists).
+struct SplitRmse {
+  double from_map_m = 0.0;
+  double from_markers_m = 0.0;
+  int num_from_map = 0;
+};
+
+SplitRmse RmseByPoseSource(const MarkerRun& run) {
+  std::vector<StampedPose> from_map;
+  std::vector<StampedPose> from_markers;
+  EXPECT_EQ(run.reports.size(), run.trajectory.size());
+  for (std::size_t i = 0; i < run.trajectory.size() && i < run.reports.size(); ++i) {
+    (run.reports[i].marker_pose ? from_markers : from_map).push_back(run.trajectory[i]);
+  }
+  return {SceneAbsoluteRmse(from_map), SceneAbsoluteRmse(from_markers),
+          static_cast<int>(from_map.size())};
+}
+
 TEST(SystemMarkers, OptionsCheck) {
   SystemOptions options;
   options.marker_map = SceneMarkers();
@@ -115,9 +134,14 @@ TEST(SystemMarkers, BlockingRunIsInTheWorldFrameWithMetricScale) {
   EXPECT_GT(run.stats.num_marker_only_poses, 0);
   EXPECT_TRUE(run.reports.back().world_aligned);
   EXPECT_FALSE(run.reports.back().marker_pose);
-  // Absolute error in the world frame, no alignment: measured 5.0 mm (the markers alone,
-  // LocateCamera per frame, give 15 mm RMS on this sequence).
-  EXPECT_LT(SceneAbsoluteRmse(run.trajectory), 0.01);
+  // Absolute error in the world frame, no alignment, of the frames the map tracked:
+  // measured 5.4 mm (5.1 mm without the whole-map adjustment at the end). The first frames,
+  // posed by the markers alone (LocateCamera) before the map exists: 19.8 mm.
+  const SplitRmse rmse = RmseByPoseSource(run);
+  EXPECT_GT(rmse.num_from_map, 60);
+  EXPECT_LT(rmse.from_map_m, 0.0075);
+  EXPECT_LT(rmse.from_markers_m, 0.03);
+  EXPECT_EQ(run.stats.num_whole_map_marker_adjustments, 1);
   // Metric: the best similarity onto the truth has scale 1 within 1% (measured 0.2%).
   EXPECT_NEAR(AlignmentScale(run.trajectory), 1.0, 0.01);
 }
@@ -127,7 +151,12 @@ TEST(SystemMarkers, ThreadedRunIsInTheWorldFrame) {
   EXPECT_TRUE(run.aligned);
   EXPECT_EQ(run.invariants, "");
   EXPECT_EQ(run.trajectory.size(), 80u);
-  EXPECT_LT(SceneAbsoluteRmse(run.trajectory), 0.01);
+  // As the blocking run; the map's frames vary with thread timing: 3.3-7.0 mm over 60 runs
+  // (median 3.6 mm); the markers-only frames 19.8 mm.
+  const SplitRmse rmse = RmseByPoseSource(run);
+  EXPECT_GT(rmse.num_from_map, 60);
+  EXPECT_LT(rmse.from_map_m, 0.01);
+  EXPECT_LT(rmse.from_markers_m, 0.03);
   EXPECT_NEAR(AlignmentScale(run.trajectory), 1.0, 0.01);
 }
 

@@ -87,6 +87,8 @@ void System::CloseMap() {
     ++stats_.num_maps_discarded;
     return;
   }
+  // Before its poses are frozen: the whole map against every marker it saw.
+  AdjustWholeMapWithMarkers("map closed");
   closed_keyframes_ = KeyframePoses();
   closed_points_ = MapPoints();
 }

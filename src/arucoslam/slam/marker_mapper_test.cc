@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 #include <set>
 #include <utility>
@@ -141,6 +142,53 @@ TEST(MarkerMapperTest, AllButOneMarkerUnknownAreMappedWithinThreeCentimetres) {
   for (std::size_t m = 1; m < scene.truth.markers.size(); ++m) {
     EXPECT_FALSE(output.markers.at(static_cast<int>(m)).fixed);
     EXPECT_DOUBLE_EQ(output.markers.at(static_cast<int>(m)).size, scene.options.marker_size_m);
+  }
+  EXPECT_EQ(scene.map.CheckInvariants(), "");
+}
+
+// Keyframe camera centres against the truth, metres (RMS).
+double KeyframeCentreRmse(const MappedScene& scene) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < scene.keyframes.size(); ++i) {
+    const Eigen::Vector3d estimate =
+        scene.map.FindKeyframe(scene.keyframes[i])->cam_from_world.Inverse().translation;
+    const Eigen::Vector3d truth =
+        scene.truth.keypoints.poses[i].cam_from_world.Inverse().translation;
+    sum += (estimate - truth).squaredNorm();
+  }
+  return std::sqrt(sum / static_cast<double>(scene.keyframes.size()));
+}
+
+// The whole-map adjustment a System runs when a map is closed and at the end of a run: every
+// marker known and fixed, the map 4% too large, turned and shifted as a monocular map aligned
+// from a few distant marker views would be.
+TEST(MarkerMapperTest, WithEveryMarkerKnownRefinePullsAMisalignedMapOntoTheWorld) {
+  MappedScene scene;
+  Build(scene,
+        Sim3(1.04, Eigen::Quaterniond(Eigen::AngleAxisd(0.03, Eigen::Vector3d::UnitY())),
+             Eigen::Vector3d(0.10, -0.05, 0.08)),
+        0.004);
+  MarkerMap known;
+  for (std::size_t m = 0; m < scene.truth.markers.size(); ++m) {
+    MarkerInfo info;
+    info.id = static_cast<int>(m);
+    info.size = scene.truth.markers[m].size;
+    info.world_from_marker = scene.truth.markers[m].world_from_marker;
+    info.fixed = true;
+    known.markers[info.id] = info;
+  }
+  MarkerMapper mapper(known);
+  AddAll(scene, mapper);
+  const double before_m = KeyframeCentreRmse(scene);
+  const MarkerBundleAdjustmentSummary summary = mapper.Refine(&scene.map);
+  ASSERT_TRUE(summary.success) << summary.message;
+  const double after_m = KeyframeCentreRmse(scene);
+  // Measured: 0.270 m before, 2.2 mm after.
+  EXPECT_GT(before_m, 0.1);
+  EXPECT_LT(after_m, 0.01);
+  for (const auto& [id, landmark] : mapper.landmarks().landmarks()) {
+    EXPECT_EQ(landmark.world_from_marker.translation,
+              scene.truth.markers[id.value].world_from_marker.translation);
   }
   EXPECT_EQ(scene.map.CheckInvariants(), "");
 }
