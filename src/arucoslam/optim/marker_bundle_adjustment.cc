@@ -1,9 +1,12 @@
 #include "arucoslam/optim/marker_bundle_adjustment.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <vector>
 
 #include "arucoslam/markers/marker_pose.h"
+#include "arucoslam/optim/reprojection_error.h"
 
 namespace arucoslam {
 
@@ -46,13 +49,57 @@ double MarkerReprojectionRmsPixels(const MarkerBundleAdjustmentProblem& problem)
   return count > 0 ? std::sqrt(sum / count) : 0.0;
 }
 
+namespace {
+
+double Median(std::vector<double> values) {
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+}  // namespace
+
+std::optional<double> BalancedCornerSigmaPx(const MarkerBundleAdjustmentProblem& problem,
+                                            double min_px, double max_px) {
+  std::vector<double> keypoints;  // |r| / sigma per keypoint observation
+  const BundleAdjustmentProblem& k = problem.keypoints;
+  for (const auto& observation : k.observations) {
+    Eigen::Vector2d residual;
+    if (ReprojectionError(k.intrinsics, observation.pixel)
+            .Evaluate(k.poses[observation.pose_index].cam_from_world,
+                      k.points[observation.point_index].p_in_world, &residual)) {
+      keypoints.push_back(residual.norm() / observation.sigma_px);
+    }
+  }
+  std::vector<double> corners;  // |r| / sigma per marker corner
+  for (const auto& observation : problem.marker_observations) {
+    const auto& marker = problem.markers[observation.marker_index];
+    Vector8d residual;
+    const MarkerCornerError error(k.intrinsics, SquareCorners(marker.size),
+                                  observation.corners_px);
+    if (!error.Evaluate(k.poses[observation.pose_index].cam_from_world, marker.world_from_marker,
+                        &residual)) {
+      continue;
+    }
+    for (int c = 0; c < 4; ++c) corners.push_back(residual.segment<2>(2 * c).norm());
+  }
+  if (keypoints.empty() || corners.empty()) return std::nullopt;
+  // Corner residuals are in pixels: divided by the keypoints' whitened median, the sigma
+  // that gives both the same median.
+  const double keypoint_median = Median(std::move(keypoints));
+  if (!(keypoint_median > 0.0)) return std::nullopt;
+  return std::clamp(Median(std::move(corners)) / keypoint_median, min_px, max_px);
+}
+
 std::string MarkerBundleAdjustmentSummary::BriefReport() const {
   std::ostringstream out;
   out << (success ? "ok" : "failed") << ", " << num_iterations << " iterations, "
       << num_residual_blocks << " residual blocks, keypoint RMS " << initial_keypoint_rms_px
       << " -> " << final_keypoint_rms_px << " px, marker RMS " << initial_marker_rms_px << " -> "
       << final_marker_rms_px << " px, outliers " << num_keypoint_outliers << " keypoint / "
-      << num_marker_outliers << " marker, " << solve_seconds << " s (" << message << ")";
+      << num_marker_outliers << " marker, ";
+  if (corner_sigma_px > 0.0) out << "corners weighted at " << corner_sigma_px << " px, ";
+  out << solve_seconds << " s (" << message << ")";
   return out.str();
 }
 

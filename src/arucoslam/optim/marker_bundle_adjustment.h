@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -63,6 +64,7 @@ struct MarkerBundleAdjustmentSummary {
   double final_keypoint_rms_px = 0.0;
   double initial_marker_rms_px = 0.0;  // unweighted RMS over all marker corners
   double final_marker_rms_px = 0.0;
+  double corner_sigma_px = 0.0;  // set when the caller re-weighted the corners (else 0)
   double solve_seconds = 0.0;
   std::vector<bool> keypoint_outliers;  // per keypoint observation, chi-square 2 dof
   std::vector<bool> marker_outliers;    // per marker observation, chi-square 8 dof
@@ -80,5 +82,12 @@ MarkerBundleAdjustmentSummary SolveMarkerBundleAdjustment(
 
 // RMS corner error in pixels over marker observations whose corners are all in front.
 double MarkerReprojectionRmsPixels(const MarkerBundleAdjustmentProblem& problem);
+
+// The corner noise (pixels) that gives the marker corners of a solved problem the same median
+// whitened residual as its keypoints (a variance-component estimate: corner and keypoint
+// noise differ by detector, and a solve weighs them by the sigmas it is given), clamped to
+// [min_px, max_px]. nullopt without residuals on either side.
+std::optional<double> BalancedCornerSigmaPx(const MarkerBundleAdjustmentProblem& problem,
+                                            double min_px, double max_px);
 
 }  // namespace arucoslam

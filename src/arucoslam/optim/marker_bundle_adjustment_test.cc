@@ -151,6 +151,24 @@ TEST(MarkerBundleAdjustmentTest, AWrongMarkerObservationIsFlagged) {
   EXPECT_LT(MaxCentreError(problem, truth), 0.02);  // the Huber loss kept it from pulling
 }
 
+// At the truth, the residuals are the noise: keypoints 0.5 px (sigma 1 px), corners 0.1 px,
+// so the corner sigma that weighs both alike is 0.2 px; clamped when asked.
+TEST(MarkerBundleAdjustmentTest, BalancedCornerSigmaFollowsTheNoiseRatio) {
+  SyntheticMarkerSceneOptions options;
+  options.noise_px = 0.5;
+  options.corner_noise_px = 0.1;
+  const MarkerBundleAdjustmentProblem scene = MakeSyntheticMarkerScene(options);
+  const std::optional<double> sigma = BalancedCornerSigmaPx(scene, 0.01, 10.0);
+  ASSERT_TRUE(sigma.has_value());
+  EXPECT_NEAR(*sigma, 0.2, 0.03);
+  EXPECT_DOUBLE_EQ(*BalancedCornerSigmaPx(scene, 0.5, 10.0), 0.5);
+  options.corner_noise_px = 1.5;
+  EXPECT_NEAR(*BalancedCornerSigmaPx(MakeSyntheticMarkerScene(options), 0.01, 10.0), 3.0, 0.45);
+  MarkerBundleAdjustmentProblem no_markers = scene;
+  no_markers.marker_observations.clear();
+  EXPECT_FALSE(BalancedCornerSigmaPx(no_markers, 0.01, 10.0).has_value());
+}
+
 TEST(MarkerBundleAdjustmentTest, InvalidProblemsAreRejectedWithAReason) {
   MarkerBundleAdjustmentProblem problem = MakeSyntheticMarkerScene(NoisyScene());
   problem.marker_observations[0].marker_index = problem.markers.size();

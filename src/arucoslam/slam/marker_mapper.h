@@ -40,6 +40,13 @@ struct MarkerMapperOptions {
   int max_pending_views = 30;
   // Corner noise given to the bundle adjustment, pixels.
   double corner_sigma_px = 1.0;
+  // Refine with the map: after a first solve with corner_sigma_px, the corner sigma is
+  // re-estimated from the residuals (BalancedCornerSigmaPx, within these bounds) and the
+  // problem solved again when it moved by more than 20%. On the demo sequence the corners
+  // fit to 0.33 px RMS and the keypoints to 1.4 px: 1 px under-weighs the markers.
+  bool balance_corner_sigma = true;
+  double min_corner_sigma_px = 0.1;
+  double max_corner_sigma_px = 4.0;
   MarkerBundleAdjustmentOptions bundle_adjustment;
 
   bool Check() const {
@@ -47,6 +54,7 @@ struct MarkerMapperOptions {
            min_consistent_views >= 2 && max_view_disagreement_m > 0.0 &&
            max_view_disagreement_fraction >= 0.0 &&
            max_pending_views >= min_consistent_views && corner_sigma_px > 0.0 &&
+           min_corner_sigma_px > 0.0 && max_corner_sigma_px >= min_corner_sigma_px &&
            bundle_adjustment.Check();
   }
 };

@@ -1,6 +1,8 @@
 // MarkerMapper's bundle adjustments: one new marker against its views, the mapped markers
 // against the recorded poses, and the whole map with every marker view (retired ones too).
+#include <cmath>
 #include <map>
+#include <optional>
 #include <utility>
 
 #include "arucoslam/slam/marker_mapper.h"
@@ -129,9 +131,21 @@ MarkerBundleAdjustmentProblem MarkerMapper::BuildProblem(const MapData* map,
 MarkerBundleAdjustmentSummary MarkerMapper::Refine(MapData* map) {
   ProblemIndex index;
   MarkerBundleAdjustmentProblem problem = BuildProblem(map, &index);
-  const MarkerBundleAdjustmentSummary summary =
+  MarkerBundleAdjustmentSummary summary =
       SolveMarkerBundleAdjustment(options_.bundle_adjustment, &problem);
   if (!summary.success) return summary;
+  if (options_.balance_corner_sigma) {
+    const std::optional<double> sigma_px = BalancedCornerSigmaPx(
+        problem, options_.min_corner_sigma_px, options_.max_corner_sigma_px);
+    if (sigma_px && std::abs(*sigma_px / options_.corner_sigma_px - 1.0) > 0.2) {
+      for (auto& observation : problem.marker_observations) observation.sigma_px = *sigma_px;
+      const MarkerBundleAdjustmentSummary second =
+          SolveMarkerBundleAdjustment(options_.bundle_adjustment, &problem);
+      if (!second.success) return second;
+      summary = second;
+      summary.corner_sigma_px = *sigma_px;
+    }
+  }
   for (std::size_t i = 0; i < index.keyframes.size(); ++i) {
     const Rigid3& cam_from_world = problem.keypoints.poses[i].cam_from_world;
     map->SetKeyframePose(index.keyframes[i], cam_from_world);
