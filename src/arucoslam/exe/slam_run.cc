@@ -46,6 +46,9 @@ SlamRunStats MakeStats(const std::string& dataset_label, const Dataset& dataset,
   out.marker_fix_frames = stats.num_marker_frames;
   out.marker_disambiguations = stats.num_marker_disambiguations;
   out.marker_only_poses = stats.num_marker_only_poses;
+  out.world_alignments = stats.num_world_alignments;
+  out.marker_drift_corrections = stats.num_marker_corrections;
+  out.whole_map_marker_adjustments = stats.num_whole_map_marker_adjustments;
   out.wall_time_s = wall_time_s;
   out.peak_memory_bytes = PeakMemoryBytes();
   out.timings_ms = {{"extraction", stats.extraction_ms.Summarize()},

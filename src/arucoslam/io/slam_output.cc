@@ -47,6 +47,9 @@ std::string FormatSlamStatsJson(const SlamRunStats& stats) {
     json["marker_locations"] = {{"frames_with_fix", stats.marker_fix_frames},
                                 {"disambiguated_by_motion", stats.marker_disambiguations},
                                 {"marker_only_poses", stats.marker_only_poses}};
+    json["marker_fusion"] = {{"world_alignments", stats.world_alignments},
+                             {"drift_corrections", stats.marker_drift_corrections},
+                             {"whole_map_adjustments", stats.whole_map_marker_adjustments}};
   }
   nlohmann::ordered_json timings = nlohmann::ordered_json::object();
   for (const auto& [stage, summary] : stats.timings_ms) {

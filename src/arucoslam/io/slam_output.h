@@ -39,6 +39,11 @@ struct SlamRunStats {
   int marker_fix_frames = 0;
   int marker_disambiguations = 0;
   int marker_only_poses = 0;
+  // ... and how the map was fused with them: world alignments, pose-graph drift
+  // corrections, bundle adjustments of a whole map with every marker view.
+  int world_alignments = 0;
+  int marker_drift_corrections = 0;
+  int whole_map_marker_adjustments = 0;
   double wall_time_s = 0.0;
   std::size_t peak_memory_bytes = 0;
   // Per-stage timings in milliseconds, e.g. {"tracking", summary}.
@@ -50,7 +55,8 @@ std::string FormatPlyPoints(const std::vector<Eigen::Vector3d>& points);
 // stats.json text: {"format": "arucoslam.stats/1", "dataset", "frames": {...},
 // "tracking": {"losses", "relocalisations", ...}, "map": {..., "loops_closed",
 // "global_bundle_adjustments"}, with markers "marker_locations": {"frames_with_fix",
-// "disambiguated_by_motion", "marker_only_poses"}, "timings_ms": {stage:
+// "disambiguated_by_motion", "marker_only_poses"}, "marker_fusion": {"world_alignments",
+// "drift_corrections", "whole_map_adjustments"}, "timings_ms": {stage:
 // {count, mean, median, p95, max}}, "wall_time_s", "peak_memory_bytes"}.
 std::string FormatSlamStatsJson(const SlamRunStats& stats);
 

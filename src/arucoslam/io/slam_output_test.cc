@@ -39,6 +39,8 @@ TEST(SlamOutput, WritesFourFilesThatReadBack) {
   stats.frames = 10;
   stats.frames_tracked = 8;
   stats.losses = 2;
+  stats.markers = true;
+  stats.whole_map_marker_adjustments = 2;
   TimingSummary summary;
   summary.count = 8;
   summary.median = 12.5;
@@ -54,6 +56,7 @@ TEST(SlamOutput, WritesFourFilesThatReadBack) {
   const std::string json = ReadTextFile(dir / "stats.json");
   EXPECT_NE(json.find("\"median\": 12.5"), std::string::npos);
   EXPECT_NE(json.find("\"tracked_fraction\": 0.8"), std::string::npos);
+  EXPECT_NE(json.find("\"whole_map_adjustments\": 2"), std::string::npos);
   EXPECT_NE(ReadTextFile(dir / "map.ply").find("element vertex 1"), std::string::npos);
   std::filesystem::remove_all(dir);
 }
