@@ -338,7 +338,7 @@ class System {
   void ResetMarkerMapping();
   void FinishMarkerMapping();
   // Bundle adjustment of the whole world-aligned map with every marker view (`when` is for
-  // the log); the mapping thread must be stopped.
+  // the log); the mapping thread must be stopped and the places' edit lock free.
   void AdjustWholeMapWithMarkers(const char* when);
   void PublishLocatingMarkers();  // mapping thread, after a keyframe's markers were added
   // Mapping thread, after FeedMarkerMapping: the pose-graph correction when the keyframe's

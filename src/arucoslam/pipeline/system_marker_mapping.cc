@@ -91,6 +91,9 @@ void System::ResetMarkerMapping() {
 
 void System::AdjustWholeMapWithMarkers(const char* when) {
   if (!marker_mapper_ || !marker_mapping_live_ || !options_.whole_map_marker_adjustment) return;
+  // A global BA of the loop closer may be solving: it is discarded, and the landmarks it
+  // writes under this lock are not touched meanwhile.
+  const std::unique_lock<std::mutex> places_lock = LockPlacesForMapMove();
   const MarkerBundleAdjustmentSummary summary = map_->Write([&](MapData& data) {
     marker_mapper_->SyncKeyframes(data);
     return marker_mapper_->Refine(&data);
