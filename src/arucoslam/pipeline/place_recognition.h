@@ -98,6 +98,11 @@ class PlaceRecognition {
   // ones fixed, mapped ones estimated). Call it holding LockMapEdits; the landmarks are read
   // and written only under that lock. Null: keypoints only.
   void SetMarkerLandmarks(MarkerLandmarks* landmarks) { marker_landmarks_ = landmarks; }
+  // ... and the marker pose priors for the loops' essential graphs (LoopCloser::SetPosePriors;
+  // the source is called on the loop-closing thread).
+  void SetLoopPosePriors(LoopCloser::PosePriorSource source, const EssentialGraphOptions& graph) {
+    closer_.SetPosePriors(std::move(source), graph);
+  }
   // Incremented by each closed loop and applied global BA: the tracking thread re-anchors
   // its last pose to its reference keyframe when this changes.
   std::uint64_t corrections() const { return corrections_; }

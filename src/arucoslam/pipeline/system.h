@@ -133,6 +133,11 @@ struct SystemOptions {
   // triggers a pose-graph correction of the whole map, with the marker pose of every
   // keyframe that sees known markers as a prior.
   bool marker_drift_correction = true;
+  // A loop closed in the world-aligned map is corrected with the same marker priors and
+  // graph weights (marker_correction_graph), no keyframe held fixed: the loop then keeps the
+  // world anchoring. High-texture route with markers, before the end-of-run adjustment:
+  // world ATE 0.461 m without, 0.058 m with them.
+  bool marker_priors_in_loops = true;
   double min_marker_correction_m = 0.05;
   double marker_correction_sigmas = 3.0;
   // A keyframe's marker location as a prior: 1 cm and 0.01 rad per marker (divided by
@@ -347,6 +352,8 @@ class System {
   // The pose-graph prior of a keyframe from its marker location (standard deviations from
   // the marker_priors options).
   KeyframePosePrior MarkerPrior(KeyframeId keyframe, const MarkerFix& fix) const;
+  // The priors of every keyframe located by known markers alone (drift correction, loops).
+  std::vector<KeyframePosePrior> KnownMarkerPriors() const;
   std::shared_ptr<const MarkerMap> LocatingMarkers() const;
   void MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& report);
   void MapKeyframe(KeyframeId keyframe);

@@ -21,9 +21,17 @@ KeyframePosePrior System::MarkerPrior(KeyframeId keyframe, const MarkerFix& fix)
   return prior;
 }
 
+std::vector<KeyframePosePrior> System::KnownMarkerPriors() const {
+  std::vector<KeyframePosePrior> priors;
+  std::lock_guard lock(keyframe_fixes_mutex_);
+  for (const auto& [id, fix] : keyframe_fixes_) {
+    if (fix.known_markers_only) priors.push_back(MarkerPrior(id, fix));
+  }
+  return priors;
+}
+
 bool System::CorrectDriftWithMarkers(KeyframeId keyframe) {
   if (!options_.marker_drift_correction || !marker_mapping_live_) return false;
-  std::vector<KeyframePosePrior> priors;
   std::optional<KeyframePosePrior> own;
   {
     std::lock_guard lock(keyframe_fixes_mutex_);
@@ -31,10 +39,8 @@ bool System::CorrectDriftWithMarkers(KeyframeId keyframe) {
     const auto found = keyframe_fixes_.find(keyframe);
     if (found == keyframe_fixes_.end() || !found->second.known_markers_only) return false;
     own = MarkerPrior(keyframe, found->second);
-    for (const auto& [id, fix] : keyframe_fixes_) {
-      if (fix.known_markers_only) priors.push_back(MarkerPrior(id, fix));
-    }
   }
+  const std::vector<KeyframePosePrior> priors = KnownMarkerPriors();
   const std::optional<double> offset_m = map_->Read([&](const MapData& data) -> std::optional<double> {
     const Keyframe* found = data.FindKeyframe(keyframe);
     if (found == nullptr) return std::nullopt;

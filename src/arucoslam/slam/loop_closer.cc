@@ -1,5 +1,7 @@
 #include "arucoslam/slam/loop_closer.h"
 
+#include <utility>
+
 #include <cmath>
 #include <set>
 
@@ -184,6 +186,11 @@ void LoopCloser::SetMetricMap(bool metric) {
   options_.essential_graph.solver.fix_scale = metric;
 }
 
+void LoopCloser::SetPosePriors(PosePriorSource source, const EssentialGraphOptions& graph) {
+  pose_priors_ = std::move(source);
+  prior_graph_ = graph;
+}
+
 LoopClosureResult LoopCloser::CloseLoop(KeyframeId current, KeyframeId candidate) {
   LoopClosureResult result;
   if (!options_.Check()) {
@@ -252,8 +259,18 @@ LoopClosureResult LoopCloser::CloseLoop(KeyframeId current, KeyframeId candidate
                            options_.essential_graph.min_covisibility_weight);
   });
   result.num_corrected_keyframes = static_cast<int>(corrected.size());
-  result.essential_graph =
-      OptimizeEssentialGraph(map_, candidate, constraints, corrected, {}, options_.essential_graph);
+  const std::vector<KeyframePosePrior> priors =
+      pose_priors_ ? pose_priors_() : std::vector<KeyframePosePrior>();
+  if (priors.empty()) {
+    result.essential_graph = OptimizeEssentialGraph(map_, candidate, constraints, corrected, {},
+                                                    options_.essential_graph);
+  } else {
+    EssentialGraphOptions graph = prior_graph_;
+    graph.solver = options_.essential_graph.solver;
+    graph.min_covisibility_weight = options_.essential_graph.min_covisibility_weight;
+    result.essential_graph =
+        OptimizeEssentialGraph(map_, KeyframeId(), constraints, corrected, priors, graph);
+  }
   if (!result.essential_graph.applied) {
     result.reason = "essential graph: " + result.essential_graph.summary.message;
     return result;

@@ -4,6 +4,7 @@
 
 #include <string>
 #include <utility>
+#include <functional>
 #include <vector>
 
 #include "arucoslam/feature/orb_matcher.h"
@@ -60,6 +61,11 @@ class LoopCloser {
   // Switches to (or from) a metric map, e.g. once markers aligned it to the world: loops are
   // then solved and corrected rigidly, keeping the scale.
   void SetMetricMap(bool metric);
+  // World-anchored map (markers): each loop's essential graph also takes these absolute pose
+  // priors (asked for at each loop) with `graph`'s edge weights, and holds no keyframe fixed
+  // when there are any. An empty source: loops are corrected about the loop keyframe alone.
+  using PosePriorSource = std::function<std::vector<KeyframePosePrior>()>;
+  void SetPosePriors(PosePriorSource source, const EssentialGraphOptions& graph);
 
   // Verifies the loop current -> candidate geometrically and, when it holds, corrects the
   // map. `candidate` comes from place recognition or from a shared marker.
@@ -77,6 +83,8 @@ class LoopCloser {
  private:
   Map& map_;
   LoopCloserOptions options_;
+  PosePriorSource pose_priors_;
+  EssentialGraphOptions prior_graph_;
   bool global_bundle_adjustment_requested_ = false;
   std::vector<std::pair<KeyframeId, KeyframeId>> closed_loops_;
 };

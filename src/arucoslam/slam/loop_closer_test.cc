@@ -90,6 +90,53 @@ TEST(LoopCloserTest, MetricMapClosesWithARigidTransform) {
   EXPECT_LT(rms_after, rms_before / 5.0);
 }
 
+// A world-anchored map: every fifth keyframe has an absolute pose prior (as its markers would
+// give, here the truth with 1 cm / 0.01 rad) that the loop's graph keeps, with no keyframe
+// held fixed; the loop alone (about keyframe 0) leaves the rest of the drift in place.
+TEST(LoopCloserTest, PosePriorsKeepTheWorldAnchoredKeyframesInPlace) {
+  SyntheticLoopOptions options;
+  options.scale_drift = 1.0;
+  LoopCloserOptions closer_options;
+  closer_options.metric_map = true;
+  WallLoop plain;
+  Build(plain, options);
+  ASSERT_TRUE(LoopCloser(plain.map, closer_options)
+                  .CloseLoop(plain.keyframes.back(), plain.keyframes[0])
+                  .closed);
+  WallLoop anchored;
+  Build(anchored, options);
+  const double rms_before = KeyframeRms(anchored);
+  std::vector<KeyframePosePrior> priors;
+  for (std::size_t i = 0; i < anchored.keyframes.size(); i += 5) {
+    KeyframePosePrior prior;
+    prior.keyframe = anchored.keyframes[i];
+    prior.world_from_cam = anchored.scene.loop.truth_cam_from_world[i].Inverse();
+    prior.information.topLeftCorner<3, 3>() *= 1.0 / (0.01 * 0.01);
+    prior.information.bottomRightCorner<3, 3>() *= 1.0 / (0.01 * 0.01);
+    priors.push_back(prior);
+  }
+  EssentialGraphOptions graph;
+  graph.edge_translation_sigma = 0.02;
+  graph.edge_rotation_sigma = 0.005;
+  graph.edge_scale_sigma = 0.01;
+  LoopCloser closer(anchored.map, closer_options);
+  int calls = 0;
+  closer.SetPosePriors([&] { ++calls; return priors; }, graph);
+  const LoopClosureResult result =
+      closer.CloseLoop(anchored.keyframes.back(), anchored.keyframes[0]);
+  ASSERT_TRUE(result.closed) << result.reason;
+  EXPECT_EQ(calls, 1);
+  EXPECT_EQ(result.essential_graph.num_priors, static_cast<int>(priors.size()));
+  const double rms_plain = KeyframeRms(plain);
+  const double rms_anchored = KeyframeRms(anchored);
+  std::printf("keyframe RMS %.3f m; loop alone %.3f m, with priors %.3f m\n", rms_before,
+              rms_plain, rms_anchored);
+  // Measured: 2.662 m before the loop, 0.151 m after it alone, 0.010 m with the priors.
+  EXPECT_LT(rms_anchored, 0.03);
+  EXPECT_GT(rms_plain, 0.1);
+  EXPECT_EQ(anchored.map.Read([](const MapData& data) { return data.CheckInvariants(); }), "");
+}
+
 // The requested global bundle adjustment then makes the whole map consistent with the
 // (exact) keypoints: lower reprojection error and keyframe error.
 TEST(LoopCloserTest, GlobalBundleAdjustmentAfterTheLoopLowersTheError) {
