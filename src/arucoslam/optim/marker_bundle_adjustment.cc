@@ -32,9 +32,11 @@ bool MarkerBundleAdjustmentProblem::Check(std::string* reason) const {
   return true;
 }
 
-double MarkerReprojectionRmsPixels(const MarkerBundleAdjustmentProblem& problem) {
-  double sum = 0.0;
-  int count = 0;
+namespace {
+
+// The corner residuals (pixels) of every marker observation whose corners are all in front.
+std::vector<Vector8d> MarkerResiduals(const MarkerBundleAdjustmentProblem& problem) {
+  std::vector<Vector8d> residuals;
   for (const auto& observation : problem.marker_observations) {
     const auto& marker = problem.markers[observation.marker_index];
     Vector8d residual;
@@ -42,9 +44,20 @@ double MarkerReprojectionRmsPixels(const MarkerBundleAdjustmentProblem& problem)
                                   observation.corners_px);
     if (error.Evaluate(problem.keypoints.poses[observation.pose_index].cam_from_world,
                        marker.world_from_marker, &residual)) {
-      sum += residual.squaredNorm();
-      count += 4;
+      residuals.push_back(residual);
     }
+  }
+  return residuals;
+}
+
+}  // namespace
+
+double MarkerReprojectionRmsPixels(const MarkerBundleAdjustmentProblem& problem) {
+  double sum = 0.0;
+  int count = 0;
+  for (const Vector8d& residual : MarkerResiduals(problem)) {
+    sum += residual.squaredNorm();
+    count += 4;
   }
   return count > 0 ? std::sqrt(sum / count) : 0.0;
 }
@@ -71,16 +84,8 @@ std::optional<double> BalancedCornerSigmaPx(const MarkerBundleAdjustmentProblem&
       keypoints.push_back(residual.norm() / observation.sigma_px);
     }
   }
-  std::vector<double> corners;  // |r| / sigma per marker corner
-  for (const auto& observation : problem.marker_observations) {
-    const auto& marker = problem.markers[observation.marker_index];
-    Vector8d residual;
-    const MarkerCornerError error(k.intrinsics, SquareCorners(marker.size),
-                                  observation.corners_px);
-    if (!error.Evaluate(k.poses[observation.pose_index].cam_from_world, marker.world_from_marker,
-                        &residual)) {
-      continue;
-    }
+  std::vector<double> corners;  // |r| per marker corner, pixels
+  for (const Vector8d& residual : MarkerResiduals(problem)) {
     for (int c = 0; c < 4; ++c) corners.push_back(residual.segment<2>(2 * c).norm());
   }
   if (keypoints.empty() || corners.empty()) return std::nullopt;

@@ -113,15 +113,17 @@ struct SystemOptions {
   // lost and restarts from the markers. A place-database relocalisation is accepted only when
   // a marker location of the frame agrees with it this closely.
   double max_marker_disagreement_m = 0.5;
-  // Once the map is world-aligned, keyframes' marker observations join local BA (known
-  // markers fixed) and markers the map lacks are mapped (system_marker_mapping.cc).
+  // Once the map is world-aligned, keyframes' marker observations join local BA and the
+  // global BA after a loop (known markers fixed) and markers the map lacks are mapped
+  // (system_marker_mapping.cc).
   bool markers_in_local_ba = true;
   bool map_unknown_markers = true;
   // A world-aligned map gets one bundle adjustment of all its keyframes and points with every
   // marker-corner observation (known markers fixed, mapped ones estimated, views of culled
   // keyframes kept) when it is closed after a loss and at Finish. On the demo sequence this
   // halves the monocular scale error (1.9% -> 0.9%) and cuts the world ATE from 0.40 to
-  // 0.24 m, for about 1 s of solving (corner weights: MarkerMapperOptions). false: at Finish only the mapped markers are refined.
+  // 0.24 m, for about 1 s of solving (corner weights: MarkerMapperOptions). false: at Finish
+  // only the mapped markers are refined.
   bool whole_map_marker_adjustment = true;
   // Mapped markers seen by at least this many keyframes locate frames like known ones
   // (marker poses and relocalisation where the known map has no marker). 0: never.

@@ -1,9 +1,8 @@
 #include "arucoslam/slam/loop_closer.h"
 
-#include <utility>
-
 #include <cmath>
 #include <set>
+#include <utility>
 
 #include "arucoslam/feature/feature_grid.h"
 #include "arucoslam/slam/projection_queries.h"

@@ -2,9 +2,9 @@
 // candidate, solves Sim3, fuses the duplicated points and optimises the essential graph.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <utility>
-#include <functional>
 #include <vector>
 
 #include "arucoslam/feature/orb_matcher.h"

@@ -83,15 +83,17 @@ void Build(MappedScene& scene, const Sim3& estimate_from_true, double drift,
   }
 }
 
-// The known map: only marker 0 of the scene.
-MarkerMap KnownMap(const MarkerBundleAdjustmentProblem& truth) {
+// The known map: the scene's first `count` markers (default: only marker 0), fixed.
+MarkerMap KnownMap(const MarkerBundleAdjustmentProblem& truth, std::size_t count = 1) {
   MarkerMap map;
-  MarkerInfo info;
-  info.id = 0;
-  info.size = truth.markers[0].size;
-  info.world_from_marker = truth.markers[0].world_from_marker;
-  info.fixed = true;
-  map.markers[0] = info;
+  for (std::size_t m = 0; m < count && m < truth.markers.size(); ++m) {
+    MarkerInfo info;
+    info.id = static_cast<int>(m);
+    info.size = truth.markers[m].size;
+    info.world_from_marker = truth.markers[m].world_from_marker;
+    info.fixed = true;
+    map.markers[info.id] = info;
+  }
   return map;
 }
 
@@ -168,16 +170,7 @@ TEST(MarkerMapperTest, WithEveryMarkerKnownRefinePullsAMisalignedMapOntoTheWorld
         Sim3(1.04, Eigen::Quaterniond(Eigen::AngleAxisd(0.03, Eigen::Vector3d::UnitY())),
              Eigen::Vector3d(0.10, -0.05, 0.08)),
         0.004);
-  MarkerMap known;
-  for (std::size_t m = 0; m < scene.truth.markers.size(); ++m) {
-    MarkerInfo info;
-    info.id = static_cast<int>(m);
-    info.size = scene.truth.markers[m].size;
-    info.world_from_marker = scene.truth.markers[m].world_from_marker;
-    info.fixed = true;
-    known.markers[info.id] = info;
-  }
-  MarkerMapper mapper(known);
+  MarkerMapper mapper(KnownMap(scene.truth, scene.truth.markers.size()));
   AddAll(scene, mapper);
   const double before_m = KeyframeCentreRmse(scene);
   const MarkerBundleAdjustmentSummary summary = mapper.Refine(&scene.map);
