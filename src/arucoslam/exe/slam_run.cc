@@ -45,10 +45,12 @@ SlamRunStats MakeStats(const std::string& dataset_label, const Dataset& dataset,
   out.map_points = static_cast<int>(system.map().NumMapPoints());
   out.marker_fix_frames = stats.num_marker_frames;
   out.marker_disambiguations = stats.num_marker_disambiguations;
+  out.map_rotation_disambiguations = stats.num_map_rotation_disambiguations;
   out.marker_only_poses = stats.num_marker_only_poses;
   out.world_alignments = stats.num_world_alignments;
   out.marker_drift_corrections = stats.num_marker_corrections;
   out.whole_map_marker_adjustments = stats.num_whole_map_marker_adjustments;
+  out.map_merges = stats.num_map_merges;
   out.wall_time_s = wall_time_s;
   out.peak_memory_bytes = PeakMemoryBytes();
   out.timings_ms = {{"extraction", stats.extraction_ms.Summarize()},

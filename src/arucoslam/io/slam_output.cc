@@ -46,10 +46,13 @@ std::string FormatSlamStatsJson(const SlamRunStats& stats) {
   if (stats.markers) {
     json["marker_locations"] = {{"frames_with_fix", stats.marker_fix_frames},
                                 {"disambiguated_by_motion", stats.marker_disambiguations},
+                                {"disambiguated_by_map_rotation",
+                                 stats.map_rotation_disambiguations},
                                 {"marker_only_poses", stats.marker_only_poses}};
     json["marker_fusion"] = {{"world_alignments", stats.world_alignments},
                              {"drift_corrections", stats.marker_drift_corrections},
-                             {"whole_map_adjustments", stats.whole_map_marker_adjustments}};
+                             {"whole_map_adjustments", stats.whole_map_marker_adjustments},
+                             {"map_merges", stats.map_merges}};
   }
   nlohmann::ordered_json timings = nlohmann::ordered_json::object();
   for (const auto& [stage, summary] : stats.timings_ms) {

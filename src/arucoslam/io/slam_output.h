@@ -38,12 +38,15 @@ struct SlamRunStats {
   // marker settled by the motion prediction, and frames whose pose came from markers alone.
   int marker_fix_frames = 0;
   int marker_disambiguations = 0;
+  int map_rotation_disambiguations = 0;  // ... of which by an unaligned map's voted orientation
   int marker_only_poses = 0;
   // ... and how the map was fused with them: world alignments, pose-graph drift
-  // corrections, bundle adjustments of a whole map with every marker view.
+  // corrections, bundle adjustments of a whole map with every marker view, closed maps
+  // merged into a later one.
   int world_alignments = 0;
   int marker_drift_corrections = 0;
   int whole_map_marker_adjustments = 0;
+  int map_merges = 0;
   double wall_time_s = 0.0;
   std::size_t peak_memory_bytes = 0;
   // Per-stage timings in milliseconds, e.g. {"tracking", summary}.

@@ -53,6 +53,32 @@ KeyframeId MapData::AddKeyframe(Keyframe keyframe, KeyframeId parent_hint) {
   return id;
 }
 
+bool MapData::Absorb(const MapData& other, KeyframeId attach_to, AbsorbedIds* ids) {
+  if (!graph_.Contains(attach_to)) return false;
+  *ids = AbsorbedIds();
+  for (const auto& [old_id, source] : other.keyframes_) {
+    Keyframe keyframe = source;
+    const KeyframeId id = keyframe_ids_.Next();
+    keyframe.id = id;
+    keyframe.map_point_ids.assign(keyframe.features.size(), MapPointId());
+    keyframes_.emplace(id, std::move(keyframe));
+    graph_.AddKeyframe(id);
+    ids->keyframes[old_id] = id;
+  }
+  for (const auto& [old_id, source] : other.points_) {
+    const MapPointId id = AddMapPoint(source);
+    ids->points[old_id] = id;
+    for (const auto& [keyframe, index] : source.observations) {
+      AddObservation(ids->keyframes.at(keyframe), index, id);
+    }
+  }
+  for (const auto& [old_id, id] : ids->keyframes) {
+    const KeyframeId old_parent = other.graph_.Parent(old_id);
+    graph_.SetParent(id, old_parent.IsValid() ? ids->keyframes.at(old_parent) : attach_to);
+  }
+  return true;
+}
+
 MapPointId MapData::AddMapPoint(MapPoint point) {
   const MapPointId id = point_ids_.Next();
   point.id = id;

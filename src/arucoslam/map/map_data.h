@@ -16,6 +16,12 @@ namespace arucoslam {
 //  - keyframe.map_point_ids[i] == p  <=>  points[p].observations[keyframe.id] == i;
 //  - the covisibility weight of a-b equals the number of points observed by both;
 //  - every keyframe but the first has a spanning-tree parent.
+// New ids of another map's keyframes and points after MapData::Absorb.
+struct AbsorbedIds {
+  std::map<KeyframeId, KeyframeId> keyframes;  // other's id -> id in this map
+  std::map<MapPointId, MapPointId> points;
+};
+
 class MapData {
  public:
   // Stores a keyframe and returns its new id. Its valid map_point_ids become observations
@@ -40,6 +46,12 @@ class MapData {
   // Fusion of duplicates: every observation of `duplicate` moves to `keep` (unless that
   // keyframe already observes `keep`), the counters add up, `duplicate` is erased.
   void ReplaceMapPoint(MapPointId duplicate, MapPointId keep);
+
+  // Map merging: every keyframe and point of `other` (already in this map's frame) is added
+  // under new ids with its observations (and so its covisibility); its spanning tree comes
+  // along, its root under `attach_to` (a keyframe of this map). First and last keyframes stay
+  // this map's. Nothing changes and false is returned when `attach_to` is unknown.
+  bool Absorb(const MapData& other, KeyframeId attach_to, AbsorbedIds* ids);
 
   void SetKeyframePose(KeyframeId keyframe, const Rigid3& cam_from_world);
   void SetMapPointPosition(MapPointId point, const Eigen::Vector3d& p_in_world);

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "arucoslam/map/map.h"
@@ -63,6 +64,50 @@ TEST(MapDataTest, ObservationsAndCovisibilityAreConsistent) {
   EXPECT_EQ(f.data.FindKeyframe(f.keyframes[2])->NumMapPoints(), 10);
   EXPECT_EQ(f.data.FirstKeyframe(), f.keyframes[0]);
   EXPECT_EQ(f.data.LastKeyframe(), f.keyframes[2]);
+}
+
+TEST(MapDataTest, AbsorbAddsAnotherMapUnderNewIds) {
+  Fixture host;
+  Fixture other;
+  other.data.SetKeyframePose(other.keyframes[2], Rigid3(Eigen::Quaterniond::Identity(),
+                                                        Eigen::Vector3d(-7, 0, 0)));
+  other.data.IncreaseFound(other.points[3], 4);
+  AbsorbedIds ids;
+  EXPECT_FALSE(host.data.Absorb(other.data, KeyframeId(99), &ids));
+  EXPECT_EQ(host.data.NumKeyframes(), 3u);
+  ASSERT_TRUE(host.data.Absorb(other.data, host.keyframes[1], &ids));
+  EXPECT_EQ(host.data.CheckInvariants(), "");
+  EXPECT_EQ(host.data.NumKeyframes(), 6u);
+  EXPECT_EQ(host.data.NumMapPoints(), 30u);
+  ASSERT_EQ(ids.keyframes.size(), 3u);
+  ASSERT_EQ(ids.points.size(), 15u);
+  const KeyframeId k0 = ids.keyframes.at(other.keyframes[0]);
+  const KeyframeId k1 = ids.keyframes.at(other.keyframes[1]);
+  const KeyframeId k2 = ids.keyframes.at(other.keyframes[2]);
+  for (const KeyframeId& id : {k0, k1, k2}) {
+    EXPECT_EQ(std::count(host.keyframes.begin(), host.keyframes.end(), id), 0);
+  }
+  // Observations and covisibility as in the other map; none across the two maps.
+  const CovisibilityGraph& graph = host.data.covisibility();
+  EXPECT_EQ(graph.Weight(k0, k1), 10);
+  EXPECT_EQ(graph.Weight(k1, k2), 10);
+  EXPECT_EQ(graph.Weight(k0, k2), 5);
+  EXPECT_EQ(graph.Weight(k0, host.keyframes[0]), 0);
+  const MapPoint* point = host.data.FindMapPoint(ids.points.at(other.points[3]));
+  ASSERT_NE(point, nullptr);
+  EXPECT_EQ(point->num_found, 5);
+  EXPECT_EQ(point->observations.at(k1), 3);
+  EXPECT_EQ(host.data.FindKeyframe(k1)->map_point_ids[3], ids.points.at(other.points[3]));
+  EXPECT_DOUBLE_EQ(host.data.FindKeyframe(k2)->cam_from_world.translation.x(), -7.0);
+  // The other map's tree hangs under the chosen keyframe; first and last stay.
+  EXPECT_EQ(graph.Parent(k0), host.keyframes[1]);
+  EXPECT_EQ(graph.Parent(k1), k0);
+  EXPECT_EQ(graph.Parent(k2), k1);
+  EXPECT_EQ(host.data.FirstKeyframe(), host.keyframes[0]);
+  EXPECT_EQ(host.data.LastKeyframe(), host.keyframes[2]);
+  // The absorbed keyframes behave as any other: erasing one re-parents its child.
+  EXPECT_TRUE(host.data.EraseKeyframe(k1));
+  EXPECT_EQ(host.data.CheckInvariants(), "");
 }
 
 TEST(MapDataTest, RejectsInvalidObservations) {

@@ -259,6 +259,23 @@ AmbiguityChoice ResolveAmbiguity(const CameraLocation& location,
   return AmbiguityChoice::kNone;
 }
 
+AmbiguityChoice ResolveAmbiguityByRotation(const CameraLocation& location,
+                                           const Eigen::Quaterniond& predicted_world_from_cam,
+                                           const AmbiguityPriorGates& gates) {
+  if (!location.found || !location.alternative_world_from_cam || !gates.Check()) {
+    return AmbiguityChoice::kNone;
+  }
+  const auto gate_units = [&](const Rigid3& pose) {
+    return RotationAngle(pose.rotation.inverse() * predicted_world_from_cam) * 180.0 / M_PI /
+           gates.max_rotation_deg;
+  };
+  const double best = gate_units(location.world_from_cam);
+  const double other = gate_units(*location.alternative_world_from_cam);
+  if (best <= 1.0 && other >= gates.min_disagreement) return AmbiguityChoice::kBest;
+  if (other <= 1.0 && best >= gates.min_disagreement) return AmbiguityChoice::kAlternative;
+  return AmbiguityChoice::kNone;
+}
+
 std::optional<Rigid3> ChosenPose(const CameraLocation& location, AmbiguityChoice choice) {
   switch (choice) {
     case AmbiguityChoice::kBest:

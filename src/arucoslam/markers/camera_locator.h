@@ -74,6 +74,12 @@ enum class AmbiguityChoice { kNone, kBest, kAlternative };
 AmbiguityChoice ResolveAmbiguity(const CameraLocation& location,
                                  const Rigid3& predicted_world_from_cam,
                                  const AmbiguityPriorGates& gates = {});
+// The same from a predicted orientation alone (world_from_cam rotation), e.g. that of a
+// keypoint map whose scale and position in the world are not known yet: the rotation gate
+// and min_disagreement of `gates` apply.
+AmbiguityChoice ResolveAmbiguityByRotation(const CameraLocation& location,
+                                           const Eigen::Quaterniond& predicted_world_from_cam,
+                                           const AmbiguityPriorGates& gates = {});
 // The pose of `choice` (kNone: nullopt).
 std::optional<Rigid3> ChosenPose(const CameraLocation& location, AmbiguityChoice choice);
 

@@ -308,6 +308,29 @@ TEST(CameraLocatorTest, MotionPriorSettlesAnAmbiguousMarker) {
   EXPECT_LT(worst_rotation_deg, 1.0);
 }
 
+// A predicted orientation alone (a keypoint map's, position and scale unknown) settles the
+// same views; a prediction between the two solutions or far from both does not.
+TEST(CameraLocatorTest, PredictedOrientationAloneSettlesAnAmbiguousMarker) {
+  std::mt19937 rng(5);
+  int settled = 0;
+  for (int k = 0; k < 12; ++k) {
+    const AmbiguousView view = MakeSingleMarkerView(0.8, 12.0, 2.0 * M_PI * k / 12, 0.05, rng);
+    if (!view.location.found || !view.location.quality.ambiguous) continue;
+    const CameraLocation& location = view.location;
+    const AmbiguityChoice choice = ResolveAmbiguityByRotation(location, view.world_from_cam.rotation);
+    ASSERT_NE(choice, AmbiguityChoice::kNone) << "view " << k;
+    ++settled;
+    EXPECT_LT(DegreesBetween(*ChosenPose(location, choice), view.world_from_cam), 1.0);
+    const Rigid3 between =
+        Interpolate(location.world_from_cam, *location.alternative_world_from_cam, 0.5);
+    EXPECT_EQ(ResolveAmbiguityByRotation(location, between.rotation), AmbiguityChoice::kNone);
+    const Eigen::Quaterniond turned =
+        view.world_from_cam.rotation * Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitY());
+    EXPECT_EQ(ResolveAmbiguityByRotation(location, turned), AmbiguityChoice::kNone);
+  }
+  EXPECT_GE(settled, 6);
+}
+
 // With the 0.3 px corner noise of rendered sequences the lower-error solution is sometimes
 // the wrong one; a prediction at the truth then picks IPPE's second solution. The right
 // solution itself is several degrees off, so wider gates than the defaults are needed.

@@ -110,6 +110,10 @@ void PlaceRecognition::IndexExistingKeyframes() {
     for (const auto& [id, keyframe] : data.keyframes()) ids.push_back(id);
     return ids;
   });
+  IndexKeyframes(keyframes);
+}
+
+void PlaceRecognition::IndexKeyframes(const std::vector<KeyframeId>& keyframes) {
   for (const KeyframeId& id : keyframes) AddToDatabase(id);
 }
 

@@ -85,6 +85,8 @@ class PlaceRecognition {
   std::optional<RelocalizationResult> Relocalize(const Frame& frame);
   // Every keyframe already in the map enters the database (a map loaded from a file).
   void IndexExistingKeyframes();
+  // ... or these (keyframes of a map merged into this one).
+  void IndexKeyframes(const std::vector<KeyframeId>& keyframes);
   // A keyframe finished local mapping: it enters the database and the loop detector.
   void KeyframeMapped(KeyframeId keyframe);
   // Held by local mapping for each keyframe, and by loop closing and world alignment.

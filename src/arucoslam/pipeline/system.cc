@@ -30,7 +30,7 @@ bool SystemOptions::Check() const {
          max_marker_disagreement_m > 0.0 && min_frames_between_anchor_keyframes >= 0 &&
          marker_mapping.Check() && new_map_after_lost_s > 0.0 &&
          min_marker_init_baseline_m > 0.0 && min_marker_init_parallax_deg >= 0.0 &&
-         marker_search.Check();
+         marker_search.Check() && rotation_vote.Check() && map_rotation_gates.Check();
 }
 
 System::System(const CameraModel& camera, const SystemOptions& options)
@@ -312,6 +312,7 @@ void System::Track(Frame& frame, FrameReport& report) {
     return;
   }
   last_state_ = TrackingState::kTracking;
+  VoteForWorldRotation(frame);
   lost_with_markers_ = 0;
   lost_since_s_.reset();
   ++frames_since_keyframe_;
@@ -376,14 +377,17 @@ void System::RecordPose(const Frame& frame, KeyframeId reference) {
 
 void System::ResetMap() {
   StopMappingThread();
-  CloseMap();
-  // Poses already in the world frame stay, frozen at their current estimate.
+  const bool kept_for_merge = CloseMap();
+  // Poses already in the world frame stay, frozen at their current estimate (those of a map
+  // kept for a merge remember their keyframe there).
   std::vector<TrackedPose> kept;
   map_->Read([&](const MapData& data) {
     for (TrackedPose pose : poses_) {
       if (!pose.in_world) continue;
+      if (kept_for_merge) pose.closed_reference = KeyframeId();  // an older closed map's
       if (const Keyframe* reference = data.FindKeyframe(pose.reference)) {
         pose.cam_from_world = PoseFromReference(pose, reference->cam_from_world);
+        if (kept_for_merge) pose.closed_reference = pose.reference;
       }
       pose.reference = KeyframeId();
       kept.push_back(pose);
@@ -398,7 +402,8 @@ void System::ResetMap() {
   mapper_ = std::make_unique<LocalMapper>(*map_, options_.mapper);
   GuardMarkerKeyframes();
   MakePlaceRecognition();
-  ResetMarkerMapping();
+  const int marker_generation = ResetMarkerMapping();
+  if (kept_for_merge) closed_map_->marker_generation = marker_generation;
   poses_ = std::move(kept);
   init_reference_.reset();
   initialisation_frames_.clear();
@@ -410,6 +415,7 @@ void System::ResetMap() {
   }
   next_alignment_anchors_ = 0;
   world_aligned_ = false;
+  rotation_vote_.Clear();
   lost_with_markers_ = 0;
   lost_since_s_.reset();
   last_state_ = TrackingState::kNotInitialized;

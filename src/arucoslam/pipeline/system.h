@@ -27,6 +27,7 @@
 #include "arucoslam/pipeline/bounded_queue.h"
 #include "arucoslam/pipeline/place_recognition.h"
 #include "arucoslam/pipeline/world_motion_prior.h"
+#include "arucoslam/pipeline/world_rotation_vote.h"
 #include "arucoslam/slam/initializer.h"
 #include "arucoslam/slam/keyframe_policy.h"
 #include "arucoslam/slam/local_mapper.h"
@@ -87,6 +88,13 @@ struct SystemOptions {
   bool resolve_ambiguity_by_motion = true;
   AmbiguityPriorGates ambiguity_gates;
   WorldMotionPriorOptions fix_motion;
+  // Before the map is aligned: the ambiguous one-marker views it tracked vote for the
+  // world's orientation relative to the map (world_rotation_vote.h); once they agree, the
+  // map's predicted orientation of a frame settles its ambiguous marker (rotation gate of
+  // map_rotation_gates).
+  bool resolve_ambiguity_by_map_rotation = true;
+  WorldRotationVoteOptions rotation_vote;
+  AmbiguityPriorGates map_rotation_gates{.max_rotation_deg = 6.0};
   // World alignment waits for this many keyframes with a usable marker location whose
   // camera centres span at least min_alignment_baseline_m (metres); it is refused when the
   // anchors' residual after alignment exceeds max_alignment_rms_m (metres).
@@ -125,6 +133,10 @@ struct SystemOptions {
   // 0.24 m, for about 1 s of solving (corner weights: MarkerMapperOptions). false: at Finish
   // only the mapped markers are refined.
   bool whole_map_marker_adjustment = true;
+  // A world-aligned map closed after a loss is kept whole and merged into the next map as
+  // soon as that one is in the world too (one map again: relocalisation and loops reach the
+  // old places, --save-map and the final adjustment hold both). false: its poses are frozen.
+  bool merge_closed_maps = true;
   // Mapped markers seen by at least this many keyframes locate frames like known ones
   // (marker poses and relocalisation where the known map has no marker). 0: never.
   int min_locating_marker_keyframes = 3;
@@ -218,6 +230,7 @@ struct SystemStats {
   int num_full_marker_scans = 0;  // frames whose markers were searched in the whole image
   int num_marker_frames = 0;      // frames with a usable marker location
   int num_marker_disambiguations = 0;  // ... of which one ambiguous marker settled by motion
+  int num_map_rotation_disambiguations = 0;  // ... by the unaligned map's voted orientation
   int num_marker_only_poses = 0;  // frames whose pose came from markers alone
   int num_world_alignments = 0;
   int num_marker_relocalizations = 0;  // tracking restarted from a marker pose
@@ -229,6 +242,7 @@ struct SystemStats {
   int num_maps_discarded = 0;          // closed maps never aligned (marker map only)
   int num_marker_corrections = 0;      // pose-graph corrections of drift by markers
   int num_whole_map_marker_adjustments = 0;  // bundle adjustments of a whole map with markers
+  int num_map_merges = 0;  // closed maps absorbed by a later map in the world
 };
 
 struct StampedPose {
@@ -285,6 +299,8 @@ class System {
     double reference_scale = 1.0;  // the reference's KeyframeScale when recorded (loops)
     Rigid3 cam_from_world;
     bool in_world = false;  // expressed in the marker world (kept across map resets)
+    // Frozen with a closed map that may still be merged: its reference keyframe there.
+    KeyframeId closed_reference;
   };
   struct MarkerAnchor {
     KeyframeId keyframe;
@@ -306,7 +322,9 @@ class System {
                                              FrameReport& report);
   bool RelocalizeWithMarkers(Frame& frame, FrameReport& report);
   // The solution of an ambiguous one-marker location that the motion predictions settle on.
-  AmbiguityChoice ResolveByMotion(const CameraLocation& location, double timestamp_s) const;
+  // `by_map_rotation`: settled by the unaligned map's voted orientation alone.
+  AmbiguityChoice ResolveByMotion(const CameraLocation& location, double timestamp_s,
+                                  bool* by_map_rotation) const;
   // True when the frame's marker location (world-aligned map) contradicts the pose.
   bool DisagreesWithMarkers(const Rigid3& cam_from_world) const;
   // Map reuse (system_map_reuse.cc): a frame before the first localisation in a loaded map,
@@ -342,7 +360,7 @@ class System {
   // after the map was replaced. Finish: final marker refinement.
   void StartMarkerMapping();
   void FeedMarkerMapping(KeyframeId keyframe);
-  void ResetMarkerMapping();
+  int ResetMarkerMapping();  // the closed map's marker generation (-1: no mapper)
   void FinishMarkerMapping();
   // Bundle adjustment of the whole world-aligned map with every marker view (`when` is for
   // the log); the mapping thread must be stopped and the places' edit lock free.
@@ -364,8 +382,13 @@ class System {
   // Recovery and marker initialisation (system_recovery.cc).
   // Called on a lost frame: true when the loss has lasted new_map_after_lost_s.
   bool LostTooLong(const Frame& frame);
-  // Keeps what must outlive the current map before it is discarded (ResetMap).
-  void CloseMap();
+  // Keeps what must outlive the current map before it is discarded (ResetMap); true when
+  // the map is kept whole for a merge (closed_map_).
+  bool CloseMap();
+  // Once the current map is in the world: the closed map joins it (MapData::Absorb), with
+  // its frozen poses, marker views, marker priors and place-database entries. Called with
+  // the mapping thread stopped and the places' edit lock held.
+  void MergeClosedMap();
   // Builds the initial map from the marker poses of the reference and `frame` directly in
   // the world; false when the marker poses do not allow it (the caller initialises as usual).
   bool InitializeFromMarkers(Frame& frame, FrameReport& report);
@@ -409,6 +432,11 @@ class System {
   std::optional<MarkerFix> fix_;               // the current frame's
   std::optional<MarkerFix> init_reference_fix_;
   WorldMotionPrior fix_motion_{options_.fix_motion};  // the recent fixes' world poses
+  // Unaligned map: the orientation votes of its ambiguous marker views, and the current
+  // frame's ambiguous location (voted once the frame is tracked).
+  WorldRotationVote rotation_vote_{options_.rotation_vote};
+  std::optional<CameraLocation> ambiguous_location_;
+  void VoteForWorldRotation(const Frame& frame);
   std::vector<MarkerAnchor> anchors_;
   bool world_aligned_ = false;
   // Until the map is aligned, keyframes that saw a marker are not culled: they carry the
@@ -424,6 +452,16 @@ class System {
   std::size_t biggest_closed_keyframes_ = 0;
   std::vector<StampedPose> closed_keyframes_;
   std::vector<Eigen::Vector3d> closed_points_;
+  // The last world-aligned map closed after a loss, kept whole until the next map is in the
+  // world and absorbs it; the output lists above end with its keyframes and points.
+  struct ClosedMap {
+    MapData data;
+    int marker_generation = -1;  // MarkerMapper::CloseMap's
+    std::map<KeyframeId, MarkerFix> keyframe_fixes;
+    std::size_t output_keyframes_before = 0;  // closed_keyframes_ entries of older maps
+    std::size_t output_points_before = 0;
+  };
+  std::optional<ClosedMap> closed_map_;
   double detection_ms_ = 0.0;  // marker detection time of the current image
   double marker_wait_ms_ = 0.0;  // the current image's wait for its detections
   // Markers of the world-aligned map; only the mapping thread touches it while it runs.

@@ -85,12 +85,12 @@ std::shared_ptr<const MarkerMap> System::LocatingMarkers() const {
   return locating_markers_;  // null until a mapped marker locates: the known map alone
 }
 
-void System::ResetMarkerMapping() {
+int System::ResetMarkerMapping() {
   marker_mapping_live_ = false;
-  if (!marker_mapper_) return;
+  if (!marker_mapper_) return -1;
   // The markers stay (they are in the world frame); the old map's keyframes are retired at
   // their world poses (their marker views still count in the final refinement).
-  marker_mapper_->CloseMap();
+  return marker_mapper_->CloseMap();
 }
 
 void System::AdjustWholeMapWithMarkers(const char* when) {

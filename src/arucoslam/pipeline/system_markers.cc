@@ -72,10 +72,12 @@ std::optional<System::MarkerFix> System::LocateWithMarkers(
   report.num_markers = static_cast<int>(location.marker_ids.size());
   std::optional<MarkerFix> fix;
   // An ambiguous location counts only as the solution the motion prediction settles on.
+  bool by_map_rotation = false;
   const AmbiguityChoice choice =
       location.found && location.quality.ambiguous && options_.resolve_ambiguity_by_motion
-          ? ResolveByMotion(location, frame.timestamp_s)
+          ? ResolveByMotion(location, frame.timestamp_s, &by_map_rotation)
           : AmbiguityChoice::kNone;
+  ambiguous_location_.reset();
   const bool resolved = choice != AmbiguityChoice::kNone;
   const bool alternative = choice == AmbiguityChoice::kAlternative;
   const Rigid3 world_from_cam =
@@ -85,9 +87,13 @@ std::optional<System::MarkerFix> System::LocateWithMarkers(
   const double nearest_sides = location.found
                                    ? NearestMarkerInSides(location, world_from_cam, known)
                                    : std::numeric_limits<double>::infinity();
-  if (location.found && (!location.quality.ambiguous || resolved) &&
-      rms_px <= options_.max_marker_rms_px &&
-      nearest_sides <= options_.max_marker_distance_sides) {
+  const bool usable =
+      rms_px <= options_.max_marker_rms_px && nearest_sides <= options_.max_marker_distance_sides;
+  if (location.found && location.quality.ambiguous && location.alternative_world_from_cam &&
+      usable && !world_aligned_ && options_.resolve_ambiguity_by_map_rotation) {
+    ambiguous_location_ = location;  // votes for the map's orientation once tracked
+  }
+  if (location.found && (!location.quality.ambiguous || resolved) && usable) {
     fix.emplace();
     fix->world_from_cam = world_from_cam;
     fix->disambiguated_by_motion = resolved;
@@ -123,6 +129,7 @@ std::optional<System::MarkerFix> System::LocateWithMarkers(
     ++stats_.num_marker_frames;
     if (fix->disambiguated_by_motion) {
       ++stats_.num_marker_disambiguations;
+      if (by_map_rotation) ++stats_.num_map_rotation_disambiguations;
       ARUCOSLAM_LOG_DEBUG("frame {}: ambiguous marker {} settled by the motion prediction{}",
                           report.index, location.marker_ids.front(),
                           alternative ? " (IPPE's second solution)" : "");
@@ -131,10 +138,12 @@ std::optional<System::MarkerFix> System::LocateWithMarkers(
   return fix;
 }
 
-AmbiguityChoice System::ResolveByMotion(const CameraLocation& location,
-                                        double timestamp_s) const {
-  // The aligned map's motion model (keypoint poses in the world) and the recent marker
-  // fixes predict independently; when both settle the ambiguity they must agree.
+AmbiguityChoice System::ResolveByMotion(const CameraLocation& location, double timestamp_s,
+                                        bool* by_map_rotation) const {
+  // The map's motion model (keypoint poses in the world; before the alignment, orientations
+  // through the voted world rotation) and the recent marker fixes predict independently;
+  // when both settle the ambiguity they must agree.
+  *by_map_rotation = false;
   if (!location.alternative_world_from_cam) return AmbiguityChoice::kNone;
   AmbiguityChoice by_tracker = AmbiguityChoice::kNone;
   bool tracker_prediction = false, fixes_prediction = false;
@@ -144,6 +153,22 @@ AmbiguityChoice System::ResolveByMotion(const CameraLocation& location,
       by_tracker = ResolveAmbiguity(location, predicted->Inverse(), options_.ambiguity_gates);
       ARUCOSLAM_LOG_DEBUG("t {:.3f}: ambiguous marker vs tracker prediction: {}", timestamp_s,
                           DistancesFrom(location, predicted->Inverse()));
+    }
+  } else if (options_.resolve_ambiguity_by_map_rotation && rotation_vote_.WorldFromMap() &&
+             tracker_->state() == TrackingState::kTracking) {
+    if (const std::optional<Rigid3> predicted = tracker_->PredictedPose()) {
+      tracker_prediction = true;
+      const Eigen::Quaterniond world_from_cam =
+          *rotation_vote_.WorldFromMap() * predicted->rotation.inverse();
+      by_tracker =
+          ResolveAmbiguityByRotation(location, world_from_cam, options_.map_rotation_gates);
+      *by_map_rotation = by_tracker != AmbiguityChoice::kNone;
+      ARUCOSLAM_LOG_DEBUG("t {:.3f}: ambiguous marker vs the map's voted orientation: {:.1f} / "
+                          "{:.1f} deg", timestamp_s,
+                          RotationAngle(location.world_from_cam.rotation.inverse() *
+                                        world_from_cam) * 180.0 / M_PI,
+                          RotationAngle(location.alternative_world_from_cam->rotation.inverse() *
+                                        world_from_cam) * 180.0 / M_PI);
     }
   }
   AmbiguityChoice by_fixes = AmbiguityChoice::kNone;
@@ -157,8 +182,19 @@ AmbiguityChoice System::ResolveByMotion(const CameraLocation& location,
     ARUCOSLAM_LOG_DEBUG("t {:.3f}: ambiguous marker, no motion prediction", timestamp_s);
   }
   if (by_tracker == AmbiguityChoice::kNone) return by_fixes;
-  if (by_fixes != AmbiguityChoice::kNone && by_fixes != by_tracker) return AmbiguityChoice::kNone;
+  if (by_fixes != AmbiguityChoice::kNone && by_fixes != by_tracker) {
+    *by_map_rotation = false;
+    return AmbiguityChoice::kNone;
+  }
+  if (by_fixes != AmbiguityChoice::kNone) *by_map_rotation = false;  // the fixes settled it too
   return by_tracker;
+}
+
+void System::VoteForWorldRotation(const Frame& frame) {
+  if (!ambiguous_location_ || world_aligned_ || !frame.cam_from_world) return;
+  rotation_vote_.Add(*frame.cam_from_world, ambiguous_location_->world_from_cam,
+                     *ambiguous_location_->alternative_world_from_cam);
+  ambiguous_location_.reset();
 }
 
 void System::GuardMarkerKeyframes() {
@@ -258,6 +294,7 @@ void System::MaybeAlignWorld(Frame* frame) {
     frame->cam_from_world = to_world(*frame->cam_from_world);
   }
   next_alignment_anchors_ = 2 * static_cast<int>(anchors.size());
+  MergeClosedMap();  // both maps in the world now
   mapping_busy_ = false;
   StartMappingThread();
   ARUCOSLAM_LOG_DEBUG("keypoint map {}aligned to the marker world: scale {:.4f}, {} of {} "
@@ -265,6 +302,7 @@ void System::MaybeAlignWorld(Frame* frame) {
                       world_aligned_ ? "re-" : "", world_from_map.scale, alignment.num_inliers,
                       anchors.size(), alignment.rms_m);
   world_aligned_ = true;
+  rotation_vote_.Clear();
   keep_marker_keyframes_ = false;
   RefreshKeyframePoseCache();
   std::lock_guard lock(stats_mutex_);

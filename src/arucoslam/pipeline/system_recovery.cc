@@ -2,6 +2,7 @@
 // and map initialisation from two marker locations, which starts a map directly in the world.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <utility>
 
@@ -70,27 +71,103 @@ bool System::LostTooLong(const Frame& frame) {
   return frame.timestamp_s - *lost_since_s_ >= options_.new_map_after_lost_s;
 }
 
-void System::CloseMap() {
+bool System::CloseMap() {
   const std::size_t keyframes = map_->NumKeyframes();
-  if (keyframes == 0) return;
+  if (keyframes == 0) return false;
   if (!options_.marker_map) {
     // Keypoints only: maps are in unrelated frames; the biggest one is the output.
     if (keyframes > biggest_closed_keyframes_) {
       biggest_closed_poses_ = CurrentMapPoses(/*world_only=*/false);
       biggest_closed_keyframes_ = keyframes;
     }
-    return;
+    return false;
   }
   if (!world_aligned_) {
     // Never aligned: its poses are dropped by ResetMap (not in the world frame).
     std::lock_guard lock(stats_mutex_);
     ++stats_.num_maps_discarded;
-    return;
+    return false;
   }
   // Before its poses are frozen: the whole map against every marker it saw.
   AdjustWholeMapWithMarkers("map closed");
+  ClosedMap closed;
+  closed.output_keyframes_before = closed_keyframes_.size();
+  closed.output_points_before = closed_points_.size();
   closed_keyframes_ = KeyframePoses();
   closed_points_ = MapPoints();
+  if (!options_.merge_closed_maps) return false;
+  closed.data = map_->Read([](const MapData& data) { return data; });
+  {
+    std::lock_guard lock(keyframe_fixes_mutex_);
+    closed.keyframe_fixes = keyframe_fixes_;
+  }
+  closed_map_ = std::move(closed);  // an older one not merged stays in the outputs only
+  return true;
+}
+
+void System::MergeClosedMap() {
+  if (!closed_map_) return;
+  ClosedMap closed = std::move(*closed_map_);
+  closed_map_.reset();
+  if (closed.data.NumKeyframes() == 0) return;
+  AbsorbedIds ids;
+  KeyframeId attach_to;
+  const bool merged = map_->Write([&](MapData& data) {
+    // The closed map's spanning tree hangs under the current keyframe nearest its root.
+    const Eigen::Vector3d root =
+        closed.data.FindKeyframe(closed.data.FirstKeyframe())->CameraCenter();
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const auto& [id, keyframe] : data.keyframes()) {
+      const double distance = (keyframe.CameraCenter() - root).squaredNorm();
+      if (distance < nearest) {
+        nearest = distance;
+        attach_to = id;
+      }
+    }
+    return attach_to.IsValid() && data.Absorb(closed.data, attach_to, &ids);
+  });
+  if (!merged) return;
+  // Its keyframes and points are the current map's now, not closed outputs.
+  closed_keyframes_.resize(closed.output_keyframes_before);
+  closed_points_.resize(closed.output_points_before);
+  // Its frozen poses follow their keyframes again.
+  int followed = 0;
+  map_->Read([&](const MapData& data) {
+    for (TrackedPose& pose : poses_) {
+      if (!pose.closed_reference.IsValid()) continue;
+      const auto found = ids.keyframes.find(pose.closed_reference);
+      pose.closed_reference = KeyframeId();
+      if (found == ids.keyframes.end()) continue;
+      pose.reference = found->second;
+      pose.cam_from_reference =
+          pose.cam_from_world * data.FindKeyframe(found->second)->cam_from_world.Inverse();
+      pose.reference_scale = ReferenceScale(found->second);
+      ++followed;
+    }
+    return 0;
+  });
+  {
+    std::lock_guard lock(keyframe_fixes_mutex_);
+    for (const auto& [old_id, fix] : closed.keyframe_fixes) {
+      const auto found = ids.keyframes.find(old_id);
+      if (found != ids.keyframes.end()) keyframe_fixes_[found->second] = fix;
+    }
+  }
+  int revived = 0;
+  if (marker_mapper_ && closed.marker_generation >= 0) {
+    revived = marker_mapper_->ReviveClosedMap(closed.marker_generation, ids.keyframes);
+  }
+  if (places_) {
+    std::vector<KeyframeId> absorbed;
+    for (const auto& [old_id, id] : ids.keyframes) absorbed.push_back(id);
+    places_->IndexKeyframes(absorbed);
+  }
+  ARUCOSLAM_LOG_DEBUG("closed map merged into the current one: {} keyframes, {} points, {} "
+                      "poses follow them, {} with marker views; attached to keyframe {}",
+                      ids.keyframes.size(), ids.points.size(), followed, revived,
+                      attach_to.value);
+  std::lock_guard lock(stats_mutex_);
+  ++stats_.num_map_merges;
 }
 
 bool System::InitializeFromMarkers(Frame& frame, FrameReport& report) {
@@ -150,6 +227,7 @@ bool System::InitializeFromMarkers(Frame& frame, FrameReport& report) {
   first.cam_from_world = to_world(*first.cam_from_world);
   frame.cam_from_world = to_world(*frame.cam_from_world);
   world_aligned_ = true;
+  rotation_vote_.Clear();
   keep_marker_keyframes_ = false;
   RefreshKeyframePoseCache();
   next_alignment_anchors_ = options_.min_alignment_anchors;  // re-aligned as anchors come

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <optional>
 #include <string>
 
@@ -26,6 +28,7 @@ struct Scenario {
   bool markers = false;          // a marker map is given
   int markers_until = 1 << 30;   // markers are detected only before this frame
   double marker_size = 0.4;      // m
+  bool merge_closed_maps = true;
 };
 
 struct ScenarioRun {
@@ -34,6 +37,7 @@ struct ScenarioRun {
   std::vector<StampedPose> keyframes;
   SystemStats stats;
   std::string invariants;
+  std::vector<double> map_keyframe_times;  // keyframes of the final map
 };
 
 ScenarioRun RunScenario(const Scenario& scenario) {
@@ -43,6 +47,7 @@ ScenarioRun RunScenario(const Scenario& scenario) {
   // The synthetic scene gives few keyframes: without this a lost map would be "young" and
   // simply reset, not closed after new_map_after_lost_s.
   options.reset_max_keyframes = 0;
+  options.merge_closed_maps = scenario.merge_closed_maps;
   if (scenario.markers) options.marker_map = SceneMarkers(11, scenario.marker_size);
   System system(camera, options);
   std::mt19937 rng(7);
@@ -66,7 +71,13 @@ ScenarioRun RunScenario(const Scenario& scenario) {
   run.trajectory = system.Trajectory();
   run.keyframes = system.KeyframePoses();
   run.stats = system.Stats();
-  run.invariants = system.map().Read([](const MapData& data) { return data.CheckInvariants(); });
+  system.map().Read([&](const MapData& data) {
+    run.invariants = data.CheckInvariants();
+    for (const auto& [id, keyframe] : data.keyframes()) {
+      run.map_keyframe_times.push_back(keyframe.timestamp_s);
+    }
+    return 0;
+  });
   return run;
 }
 
@@ -131,6 +142,40 @@ TEST(SystemRecovery, NewMapAfterLossIsInitialisedFromMarkersInTheWorld) {
             scenario.num_frames - (scenario.blackout_end - scenario.blackout_begin));
   EXPECT_LT(SceneAbsoluteRmse(run.trajectory), 0.02);
   EXPECT_EQ(run.invariants, "");
+}
+
+int CountBefore(const std::vector<double>& times, double limit_s) {
+  return static_cast<int>(std::count_if(times.begin(), times.end(),
+                                        [&](double t) { return t < limit_s; }));
+}
+
+// Once the second map is in the world, the first one (closed at the loss) joins it: one map
+// holds both sides of the blackout, each keyframe is output once, the poses stay as accurate.
+TEST(SystemRecovery, ClosedMapIsMergedIntoTheNextMapInTheWorld) {
+  Scenario scenario;
+  scenario.markers = true;
+  const ScenarioRun merged = RunScenario(scenario);
+  scenario.merge_closed_maps = false;
+  const ScenarioRun apart = RunScenario(scenario);
+  const double blackout_s = kSceneDt * scenario.blackout_begin;
+  EXPECT_EQ(merged.stats.num_map_merges, 1);
+  EXPECT_EQ(apart.stats.num_map_merges, 0);
+  EXPECT_EQ(merged.invariants, "");
+  // Apart: the final map starts after the blackout; merged: it holds the first map too.
+  EXPECT_EQ(CountBefore(apart.map_keyframe_times, blackout_s), 0);
+  const int first_map_keyframes = CountBefore(merged.map_keyframe_times, blackout_s);
+  EXPECT_GE(first_map_keyframes, 3);
+  EXPECT_GT(static_cast<int>(merged.map_keyframe_times.size()), first_map_keyframes);
+  // The output lists each keyframe once: the closed map's are no longer listed apart.
+  EXPECT_EQ(merged.keyframes.size(), merged.map_keyframe_times.size());
+  std::vector<double> output_times;
+  for (const StampedPose& pose : merged.keyframes) output_times.push_back(pose.timestamp_s);
+  EXPECT_EQ(CountBefore(output_times, blackout_s), first_map_keyframes);
+  EXPECT_EQ(merged.trajectory.size(), apart.trajectory.size());
+  EXPECT_LT(SceneAbsoluteRmse(merged.trajectory), 0.02);
+  std::printf("first map: %d keyframes merged; world RMSE merged %.4f m, apart %.4f m\n",
+              first_map_keyframes, SceneAbsoluteRmse(merged.trajectory),
+              SceneAbsoluteRmse(apart.trajectory));
 }
 
 TEST(SystemRecovery, MapNeverAlignedStaysOutOfTheWorldTrajectory) {

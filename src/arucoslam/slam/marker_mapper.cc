@@ -78,11 +78,37 @@ void MarkerMapper::SyncKeyframes(const MapData& map) {
   for (const KeyframeId& id : gone) Retire(id);
 }
 
-void MarkerMapper::CloseMap() {
+int MarkerMapper::CloseMap() {
   std::vector<KeyframeId> live;
-  for (const auto& [id, record] : live_) live.push_back(id);
+  for (const auto& [id, record] : live_) {
+    live.push_back(id);
+    records_.at(record).closed_as = id;
+  }
   for (const KeyframeId& id : live) Retire(id);
-  ++generation_;
+  return generation_++;
+}
+
+int MarkerMapper::ReviveClosedMap(int generation,
+                                  const std::map<KeyframeId, KeyframeId>& new_ids) {
+  int revived = 0;
+  for (auto& [index, record] : records_) {
+    if (record.generation != generation || record.keyframe.IsValid()) continue;
+    const auto found = new_ids.find(record.closed_as);
+    if (!record.closed_as.IsValid() || found == new_ids.end() || live_.count(found->second)) {
+      continue;
+    }
+    record.keyframe = found->second;
+    record.generation = generation_;
+    record.closed_as = KeyframeId();
+    live_[record.keyframe] = index;
+    for (const MarkerObservation& observation : record.markers) {
+      if (landmarks_.Contains(observation.marker_id)) {
+        landmarks_.AddObservation(observation.marker_id, record.keyframe, observation.corners_px);
+      }
+    }
+    ++revived;
+  }
+  return revived;
 }
 
 void MarkerMapper::ApplySimilarity(const Sim3& new_from_old) {

@@ -76,8 +76,12 @@ class MarkerMapper {
   // last pose, for pending markers and the final refinement.
   void SyncKeyframes(const MapData& map);
   // The map was replaced: every recorded keyframe is retired (its pose is in the world) and
-  // later similarity moves no longer apply to them.
-  void CloseMap();
+  // later similarity moves no longer apply to them. Returns the closed map's generation.
+  int CloseMap();
+  // The map of `generation`, closed, was merged into the current one (MapData::Absorb,
+  // `new_ids` from it): the records CloseMap retired come back as live keyframes of the
+  // current map under their new ids, views and poses unchanged. Returns how many.
+  int ReviveClosedMap(int generation, const std::map<KeyframeId, KeyframeId>& new_ids);
   // The current map was moved by `new_from_old` (a world re-alignment): the recorded poses
   // of its keyframes, live and retired, move with it. (The landmarks are moved by the caller.)
   void ApplySimilarity(const Sim3& new_from_old);
@@ -107,6 +111,7 @@ class MarkerMapper {
     Rigid3 cam_from_world;
     CameraModel camera;
     std::vector<MarkerObservation> markers;
+    KeyframeId closed_as = KeyframeId();  // the keyframe CloseMap retired it from
   };
   struct View {
     int record = 0;  // into records_
