@@ -14,6 +14,8 @@
 #include "arucoslam/eval/evaluation.h"
 #include "arucoslam/exe/command_test_util.h"
 #include "arucoslam/exe/default_vocabulary.h"
+#include "arucoslam/exe/slam_run.h"
+#include "arucoslam/io/marker_map_json.h"
 #include "arucoslam/io/dataset_reader.h"
 #include "arucoslam/pipeline/system.h"
 #include "arucoslam/util/files.h"
@@ -95,6 +97,7 @@ fs::path RenderSequence(const fs::path& dir, const std::string& name,
                         bool close_the_loop) {
   const fs::path world = dir / (name + "_world");
   const fs::path seq = dir / (name + "_seq");
+  if (fs::exists(seq / "mav0")) return seq;  // rendered by an earlier test of the suite
   const auto made = RunArucoslam("world factory " + world_options + " --out " + world.string());
   EXPECT_EQ(made.status, 0) << made.output;
   nlohmann::json path = nlohmann::json::parse(ReadTextFile(world / "path.json"));
@@ -213,6 +216,49 @@ TEST_F(PlacesEndToEnd, TrackingResumesWithinOneSecondAfterATwoSecondGap) {
   EXPECT_GE(run.trajectory.size(), 0.9 * (dataset.size() - (gap_end - gap_begin)));
   // One Sim(3) for the poses before and after the gap: a jump at the gap would show here.
   EXPECT_LT(run.ate_m, 1.5 * reference.ate_m);
+}
+
+// A loop closed in the marker world: the same loop with its markers.json, the options of
+// `arucoslam run`. The map is in the world from the first markers on; the loop at the return
+// is corrected with the markers' pose priors in its graph and marker corners in its global BA
+// (no keyframe held fixed). Measured (`run --blocking`, with and without --no-loop-closing):
+// world-frame ATE 0.104 m open, 0.042 m closed, one loop.
+TEST_F(PlacesEndToEnd, ALoopClosedInTheMarkerWorldStaysInTheWorld) {
+  const fs::path sequence = RenderSequence(*dir_, "loop",
+                                           "--seed 3 --texture medium --aisles 1 --aisle-length 6",
+                                           0.0, true);
+  const Dataset dataset = Dataset::Open(sequence);
+  ASSERT_TRUE(dataset.markers_path().has_value());
+  const auto run = [&](bool loop_closing) {
+    SystemOptions options = DefaultRunOptions(/*blocking=*/true, *vocabulary_, loop_closing);
+    options.marker_map = ReadMarkerMapJson(*dataset.markers_path());
+    System system(dataset.camera(), options);
+    for (std::size_t i = 0; i < dataset.size(); ++i) {
+      system.ProcessImage(dataset.LoadImage(i), dataset.frame(i).timestamp_s);
+    }
+    system.Finish();
+    RunOutcome outcome;
+    for (const StampedPose& pose : system.Trajectory()) {
+      outcome.trajectory.Add(pose.timestamp_s, pose.world_from_cam);
+    }
+    outcome.stats = system.Stats();
+    EvaluationOptions evaluation;
+    evaluation.alignment.mode = AlignmentMode::kNone;  // the world frame itself
+    outcome.ate_m = EvaluateTrajectory(dataset.ground_truth(), outcome.trajectory, "run",
+                                       "system", evaluation)
+                        .ape_translation.rmse;
+    return outcome;
+  };
+  const RunOutcome open = run(false);
+  const RunOutcome closed = run(true);
+  std::printf("world-frame ATE open %.3f m, closed %.3f m; %zu loops closed\n", open.ate_m,
+              closed.ate_m, closed.stats.places.loops.size());
+  EXPECT_GE(closed.stats.num_world_alignments, 1);
+  ASSERT_GE(closed.stats.places.loops.size(), 1u);
+  EXPECT_EQ(CountFalseLoops(dataset, closed), 0);
+  EXPECT_GE(closed.trajectory.size(), 0.95 * dataset.size());
+  EXPECT_LT(closed.ate_m, 0.06);
+  EXPECT_LE(closed.ate_m, 0.6 * open.ate_m);
 }
 
 // Acceptance (b) on the first 20 s of the default low-texture factory (300 frames): every

@@ -45,16 +45,26 @@ std::string BundleAdjustmentSummary::BriefReport() const {
 double ReprojectionRmsPixels(const BundleAdjustmentProblem& problem) {
   double sum = 0.0;
   int count = 0;
+  VisitReprojectionResiduals(
+      problem, [&](const BundleAdjustmentProblem::Observation&, const Eigen::Vector2d& residual) {
+        sum += residual.squaredNorm();
+        ++count;
+      });
+  return count > 0 ? std::sqrt(sum / count) : 0.0;
+}
+
+void VisitReprojectionResiduals(
+    const BundleAdjustmentProblem& problem,
+    const std::function<void(const BundleAdjustmentProblem::Observation&,
+                             const Eigen::Vector2d&)>& visit) {
   for (const auto& observation : problem.observations) {
     Eigen::Vector2d residual;
     if (ReprojectionError(problem.intrinsics, observation.pixel)
             .Evaluate(problem.poses[observation.pose_index].cam_from_world,
                       problem.points[observation.point_index].p_in_world, &residual)) {
-      sum += residual.squaredNorm();
-      ++count;
+      visit(observation, residual);
     }
   }
-  return count > 0 ? std::sqrt(sum / count) : 0.0;
 }
 
 }  // namespace arucoslam

@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -79,5 +80,10 @@ BundleAdjustmentSummary SolveBundleAdjustment(const BundleAdjustmentOptions& opt
 
 // Reprojection RMS in pixels over all observations in front of their camera.
 double ReprojectionRmsPixels(const BundleAdjustmentProblem& problem);
+// Calls `visit(observation, residual_px)` for each observation in front of its camera.
+void VisitReprojectionResiduals(
+    const BundleAdjustmentProblem& problem,
+    const std::function<void(const BundleAdjustmentProblem::Observation&,
+                             const Eigen::Vector2d&)>& visit);
 
 }  // namespace arucoslam

@@ -75,15 +75,11 @@ double Median(std::vector<double> values) {
 std::optional<double> BalancedCornerSigmaPx(const MarkerBundleAdjustmentProblem& problem,
                                             double min_px, double max_px) {
   std::vector<double> keypoints;  // |r| / sigma per keypoint observation
-  const BundleAdjustmentProblem& k = problem.keypoints;
-  for (const auto& observation : k.observations) {
-    Eigen::Vector2d residual;
-    if (ReprojectionError(k.intrinsics, observation.pixel)
-            .Evaluate(k.poses[observation.pose_index].cam_from_world,
-                      k.points[observation.point_index].p_in_world, &residual)) {
-      keypoints.push_back(residual.norm() / observation.sigma_px);
-    }
-  }
+  VisitReprojectionResiduals(problem.keypoints,
+                             [&](const BundleAdjustmentProblem::Observation& observation,
+                                 const Eigen::Vector2d& residual) {
+                               keypoints.push_back(residual.norm() / observation.sigma_px);
+                             });
   std::vector<double> corners;  // |r| per marker corner, pixels
   for (const Vector8d& residual : MarkerResiduals(problem)) {
     for (int c = 0; c < 4; ++c) corners.push_back(residual.segment<2>(2 * c).norm());

@@ -416,6 +416,7 @@ void System::ResetMap() {
   next_alignment_anchors_ = 0;
   world_aligned_ = false;
   rotation_vote_.Clear();
+  absorbed_keyframes_.clear();
   lost_with_markers_ = 0;
   lost_since_s_.reset();
   last_state_ = TrackingState::kNotInitialized;

@@ -11,6 +11,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -387,8 +388,8 @@ class System {
   bool CloseMap();
   // Once the current map is in the world: the closed map joins it (MapData::Absorb), with
   // its frozen poses, marker views, marker priors and place-database entries. Called with
-  // the mapping thread stopped and the places' edit lock held.
-  void MergeClosedMap();
+  // the mapping thread stopped and the places' edit lock held. True when it merged.
+  bool MergeClosedMap();
   // Builds the initial map from the marker poses of the reference and `frame` directly in
   // the world; false when the marker poses do not allow it (the caller initialises as usual).
   bool InitializeFromMarkers(Frame& frame, FrameReport& report);
@@ -462,6 +463,10 @@ class System {
     std::size_t output_points_before = 0;
   };
   std::optional<ClosedMap> closed_map_;
+  // Keyframes the current map absorbed from a closed one (already in the world: world
+  // re-alignments leave them in place) and whether a point links them to the rest.
+  std::set<KeyframeId> absorbed_keyframes_;
+  bool LinkedToAbsorbedMap() const;
   double detection_ms_ = 0.0;  // marker detection time of the current image
   double marker_wait_ms_ = 0.0;  // the current image's wait for its detections
   // Markers of the world-aligned map; only the mapping thread touches it while it runs.

@@ -270,12 +270,25 @@ void System::MaybeAlignWorld(Frame* frame) {
   }
   const Sim3& world_from_map = alignment.world_from_map;
   StopMappingThread();  // every queued keyframe is mapped first; mapping is idle below
+  if (world_aligned_ && !absorbed_keyframes_.empty() && LinkedToAbsorbedMap()) {
+    // A merged map that shares points with this one now (a loop, fused points): a
+    // re-alignment from this map's anchors alone would tear them apart. Markers correct the
+    // map by fusion from here on (drift correction, marker corners in bundle adjustment).
+    next_alignment_anchors_ = options_.max_realignment_anchors + 1;
+    anchors_.clear();
+    mapping_busy_ = false;
+    StartMappingThread();
+    ARUCOSLAM_LOG_DEBUG("world re-alignment stopped: the merged map is linked to this one");
+    return;
+  }
+  // A merged map not linked yet stays where it is (already in the world).
+  const std::set<KeyframeId>* stay = absorbed_keyframes_.empty() ? nullptr : &absorbed_keyframes_;
   const std::unique_lock<std::mutex> places_lock = LockPlacesForMapMove();
   // On a re-alignment the markers mapped in the previous estimate of the world move too.
   MarkerLandmarks* mapped =
       marker_mapping_live_ ? marker_mapper_->mutable_landmarks() : nullptr;
-  map_->Write([&](MapData& data) { ApplyWorldAlignment(world_from_map, &data, mapped); });
-  if (mapped != nullptr) marker_mapper_->ApplySimilarity(world_from_map);
+  map_->Write([&](MapData& data) { ApplyWorldAlignment(world_from_map, &data, mapped, stay); });
+  if (mapped != nullptr) marker_mapper_->ApplySimilarity(world_from_map, stay);
   StartMarkerMapping();
   tracker_->ApplySimilarity(world_from_map);
   const auto to_world = [&](const Rigid3& cam_from_map) {
@@ -284,7 +297,8 @@ void System::MaybeAlignWorld(Frame* frame) {
   for (TrackedPose& pose : poses_) {
     // Marker-only and frozen poses (no reference) are in the world already; on a
     // re-alignment the poses tied to this map's keyframes move with them.
-    const bool moves = !pose.in_world || (world_aligned_ && pose.reference.IsValid());
+    const bool moves = !pose.in_world || (world_aligned_ && pose.reference.IsValid() &&
+                                           absorbed_keyframes_.count(pose.reference) == 0);
     if (!moves) continue;
     pose.cam_from_world = to_world(pose.cam_from_world);
     pose.cam_from_reference.translation *= world_from_map.scale;
@@ -294,7 +308,7 @@ void System::MaybeAlignWorld(Frame* frame) {
     frame->cam_from_world = to_world(*frame->cam_from_world);
   }
   next_alignment_anchors_ = 2 * static_cast<int>(anchors.size());
-  MergeClosedMap();  // both maps in the world now
+  MergeClosedMap();
   mapping_busy_ = false;
   StartMappingThread();
   ARUCOSLAM_LOG_DEBUG("keypoint map {}aligned to the marker world: scale {:.4f}, {} of {} "

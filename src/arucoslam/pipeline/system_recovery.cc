@@ -105,11 +105,24 @@ bool System::CloseMap() {
   return true;
 }
 
-void System::MergeClosedMap() {
-  if (!closed_map_) return;
+bool System::LinkedToAbsorbedMap() const {
+  return map_->Read([&](const MapData& data) {
+    for (const auto& [id, point] : data.map_points()) {
+      bool absorbed = false, current = false;
+      for (const auto& [keyframe, index] : point.observations) {
+        (absorbed_keyframes_.count(keyframe) != 0 ? absorbed : current) = true;
+      }
+      if (absorbed && current) return true;
+    }
+    return false;
+  });
+}
+
+bool System::MergeClosedMap() {
+  if (!closed_map_) return false;
   ClosedMap closed = std::move(*closed_map_);
   closed_map_.reset();
-  if (closed.data.NumKeyframes() == 0) return;
+  if (closed.data.NumKeyframes() == 0) return false;
   AbsorbedIds ids;
   KeyframeId attach_to;
   const bool merged = map_->Write([&](MapData& data) {
@@ -126,7 +139,7 @@ void System::MergeClosedMap() {
     }
     return attach_to.IsValid() && data.Absorb(closed.data, attach_to, &ids);
   });
-  if (!merged) return;
+  if (!merged) return false;
   // Its keyframes and points are the current map's now, not closed outputs.
   closed_keyframes_.resize(closed.output_keyframes_before);
   closed_points_.resize(closed.output_points_before);
@@ -157,17 +170,19 @@ void System::MergeClosedMap() {
   if (marker_mapper_ && closed.marker_generation >= 0) {
     revived = marker_mapper_->ReviveClosedMap(closed.marker_generation, ids.keyframes);
   }
-  if (places_) {
-    std::vector<KeyframeId> absorbed;
-    for (const auto& [old_id, id] : ids.keyframes) absorbed.push_back(id);
-    places_->IndexKeyframes(absorbed);
+  std::vector<KeyframeId> absorbed;
+  for (const auto& [old_id, id] : ids.keyframes) {
+    absorbed.push_back(id);
+    absorbed_keyframes_.insert(id);
   }
+  if (places_) places_->IndexKeyframes(absorbed);
   ARUCOSLAM_LOG_DEBUG("closed map merged into the current one: {} keyframes, {} points, {} "
                       "poses follow them, {} with marker views; attached to keyframe {}",
                       ids.keyframes.size(), ids.points.size(), followed, revived,
                       attach_to.value);
   std::lock_guard lock(stats_mutex_);
   ++stats_.num_map_merges;
+  return true;
 }
 
 bool System::InitializeFromMarkers(Frame& frame, FrameReport& report) {

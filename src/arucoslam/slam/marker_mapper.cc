@@ -111,9 +111,10 @@ int MarkerMapper::ReviveClosedMap(int generation,
   return revived;
 }
 
-void MarkerMapper::ApplySimilarity(const Sim3& new_from_old) {
+void MarkerMapper::ApplySimilarity(const Sim3& new_from_old, const std::set<KeyframeId>* stay) {
   for (auto& [id, record] : records_) {
     if (record.generation != generation_) continue;
+    if (stay != nullptr && stay->count(record.keyframe) != 0) continue;
     record.cam_from_world = new_from_old.TransformPose(record.cam_from_world.Inverse()).Inverse();
   }
 }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <map>
+#include <set>
 #include <vector>
 
 #include "arucoslam/geometry/sim3.h"
@@ -83,8 +84,9 @@ class MarkerMapper {
   // current map under their new ids, views and poses unchanged. Returns how many.
   int ReviveClosedMap(int generation, const std::map<KeyframeId, KeyframeId>& new_ids);
   // The current map was moved by `new_from_old` (a world re-alignment): the recorded poses
-  // of its keyframes, live and retired, move with it. (The landmarks are moved by the caller.)
-  void ApplySimilarity(const Sim3& new_from_old);
+  // of its keyframes, live and retired, move with it, but those of the keyframes in `stay`
+  // when given. (The landmarks are moved by the caller.)
+  void ApplySimilarity(const Sim3& new_from_old, const std::set<KeyframeId>* stay = nullptr);
 
   // Bundle adjustment of every keyframe and point of `map` with the marker observations:
   // known markers fixed, mapped ones estimated. Poses, points and marker poses are written

@@ -182,15 +182,23 @@ WorldAlignment EstimateWorldFromMap(const std::vector<WorldAnchor>& anchors,
   return result;
 }
 
-void ApplyWorldAlignment(const Sim3& world_from_map, MapData* map, MarkerLandmarks* markers) {
+void ApplyWorldAlignment(const Sim3& world_from_map, MapData* map, MarkerLandmarks* markers,
+                         const std::set<KeyframeId>* stay) {
+  const auto stays = [&](KeyframeId id) { return stay != nullptr && stay->count(id) != 0; };
   std::vector<std::pair<KeyframeId, Rigid3>> poses;
   for (const auto& [id, keyframe] : map->keyframes()) {
+    if (stays(id)) continue;
     poses.emplace_back(id,
                        world_from_map.TransformPose(keyframe.cam_from_world.Inverse()).Inverse());
   }
   for (const auto& [id, pose] : poses) map->SetKeyframePose(id, pose);
   std::vector<MapPointId> points;
-  for (const auto& [id, point] : map->map_points()) points.push_back(id);
+  for (const auto& [id, point] : map->map_points()) {
+    const bool seen_by_staying = std::any_of(
+        point.observations.begin(), point.observations.end(),
+        [&](const auto& observation) { return stays(observation.first); });
+    if (!seen_by_staying) points.push_back(id);
+  }
   for (const MapPointId id : points) {
     map->SetMapPointPosition(id, world_from_map * map->FindMapPoint(id)->p_in_world);
     map->UpdateNormalAndDepth(id);

@@ -2,6 +2,7 @@
 // frame and scale) into the marker world, from keyframes whose world pose markers gave.
 #pragma once
 
+#include <set>
 #include <string>
 #include <vector>
 
@@ -70,8 +71,11 @@ WorldAlignment EstimateWorldFromMap(const std::vector<WorldAnchor>& anchors,
                                     const WorldAlignmentOptions& options = {});
 
 // Moves every keyframe and map point of `map` by world_from_map (points' normals and
-// distance ranges recomputed) and, when given, every non-fixed marker of `markers`.
+// distance ranges recomputed) and, when given, every non-fixed marker of `markers`. With
+// `stay`: those keyframes, and the points one of them observes, do not move (a part of the
+// map already in the world, e.g. a merged map not yet linked to the rest).
 void ApplyWorldAlignment(const Sim3& world_from_map, MapData* map,
-                         MarkerLandmarks* markers = nullptr);
+                         MarkerLandmarks* markers = nullptr,
+                         const std::set<KeyframeId>* stay = nullptr);
 
 }  // namespace arucoslam

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <random>
+#include <set>
 
 #include "arucoslam/markers/camera_locator.h"
 #include "arucoslam/optim/marker_bundle_adjustment_synthetic.h"
@@ -191,6 +192,33 @@ TEST(WorldAlignmentTest, ApplyMovesKeyframesPointsAndMappedMarkers) {
       (markers.Find(MarkerId(2))->world_from_marker.translation - Eigen::Vector3d(3, 0, 1)).norm(),
       1e-12);
   EXPECT_EQ(map.CheckInvariants(), "");
+}
+
+// A merged part already in the world stays: its keyframes, and the points one of them sees.
+TEST(WorldAlignmentTest, KeyframesThatStayAndTheirPointsDoNotMove) {
+  MapData map;
+  Keyframe keyframe;
+  keyframe.features.keypoints.assign(2, cv::KeyPoint(10.0f, 10.0f, 31.0f));
+  keyframe.cam_from_world.translation = Eigen::Vector3d(0.0, 0.0, 1.0);
+  const KeyframeId moving = map.AddKeyframe(keyframe);
+  keyframe.cam_from_world.translation = Eigen::Vector3d(5.0, 0.0, 1.0);
+  const KeyframeId staying = map.AddKeyframe(keyframe);
+  MapPoint point;
+  point.p_in_world = Eigen::Vector3d(1.0, 2.0, 5.0);
+  const MapPointId own = map.AddMapPoint(point);     // seen by the moving keyframe only
+  const MapPointId shared = map.AddMapPoint(point);  // seen by both
+  ASSERT_TRUE(map.AddObservation(moving, 0, own));
+  ASSERT_TRUE(map.AddObservation(moving, 1, shared));
+  ASSERT_TRUE(map.AddObservation(staying, 1, shared));
+  const std::set<KeyframeId> stay = {staying};
+  ApplyWorldAlignment(kMapFromWorld, &map, nullptr, &stay);
+  const Rigid3 expected = kMapFromWorld.TransformPose(Rigid3(Eigen::Quaterniond::Identity(),
+                                                             Eigen::Vector3d(0.0, 0.0, -1.0)));
+  EXPECT_LT((map.FindKeyframe(moving)->cam_from_world.Inverse().translation -
+             expected.translation).norm(), 1e-12);
+  EXPECT_EQ(map.FindKeyframe(staying)->cam_from_world.translation, Eigen::Vector3d(5, 0, 1));
+  EXPECT_LT((map.FindMapPoint(own)->p_in_world - kMapFromWorld * point.p_in_world).norm(), 1e-12);
+  EXPECT_EQ(map.FindMapPoint(shared)->p_in_world, point.p_in_world);
 }
 
 // The pieces together on a monocular map at a third of the metric scale: camera poses from
