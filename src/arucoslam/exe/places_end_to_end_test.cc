@@ -34,15 +34,11 @@ struct RunOutcome {
   double scale = 1.0;         // metres per map unit (the Sim(3) fit)
 };
 
-// Runs the System over `dataset` (frames in [skip_begin, skip_end) are not given to it).
-RunOutcome RunSystem(const Dataset& dataset, const std::shared_ptr<const Vocabulary>& vocabulary,
-                     bool loop_closing, std::size_t skip_begin = 0, std::size_t skip_end = 0,
-                     int min_fast_threshold = OrbExtractorOptions().min_fast_threshold) {
-  SystemOptions options;
-  options.blocking = true;
-  options.vocabulary = vocabulary;
-  options.places.loop_closing = loop_closing;
-  options.extractor.min_fast_threshold = min_fast_threshold;
+// Runs a System with `options` over `dataset` (frames in [skip_begin, skip_end) are not given
+// to it) and evaluates its trajectory with `alignment`.
+RunOutcome RunWithOptions(const Dataset& dataset, const SystemOptions& options,
+                          AlignmentMode alignment, std::size_t skip_begin = 0,
+                          std::size_t skip_end = 0) {
   System system(dataset.camera(), options);
   for (std::size_t i = 0; i < dataset.size(); ++i) {
     if (i >= skip_begin && i < skip_end) continue;
@@ -55,13 +51,25 @@ RunOutcome RunSystem(const Dataset& dataset, const std::shared_ptr<const Vocabul
   }
   outcome.stats = system.Stats();
   EvaluationOptions evaluation;
-  evaluation.alignment.mode = AlignmentMode::kSim3;
+  evaluation.alignment.mode = alignment;
   const TrajectoryEvaluation result = EvaluateTrajectory(
       dataset.ground_truth(), outcome.trajectory, "run", "system", evaluation);
   outcome.ate_m = result.ape_translation.rmse;
   outcome.rpe_m = result.relative.at(0).translation.rmse;
   outcome.scale = result.sim3_scale;
   return outcome;
+}
+
+// Keypoints only, blocking, Sim(3)-aligned evaluation.
+RunOutcome RunSystem(const Dataset& dataset, const std::shared_ptr<const Vocabulary>& vocabulary,
+                     bool loop_closing, std::size_t skip_begin = 0, std::size_t skip_end = 0,
+                     int min_fast_threshold = OrbExtractorOptions().min_fast_threshold) {
+  SystemOptions options;
+  options.blocking = true;
+  options.vocabulary = vocabulary;
+  options.places.loop_closing = loop_closing;
+  options.extractor.min_fast_threshold = min_fast_threshold;
+  return RunWithOptions(dataset, options, AlignmentMode::kSim3, skip_begin, skip_end);
 }
 
 // Ground truth pose nearest in time.
@@ -232,22 +240,7 @@ TEST_F(PlacesEndToEnd, ALoopClosedInTheMarkerWorldStaysInTheWorld) {
   const auto run = [&](bool loop_closing) {
     SystemOptions options = DefaultRunOptions(/*blocking=*/true, *vocabulary_, loop_closing);
     options.marker_map = ReadMarkerMapJson(*dataset.markers_path());
-    System system(dataset.camera(), options);
-    for (std::size_t i = 0; i < dataset.size(); ++i) {
-      system.ProcessImage(dataset.LoadImage(i), dataset.frame(i).timestamp_s);
-    }
-    system.Finish();
-    RunOutcome outcome;
-    for (const StampedPose& pose : system.Trajectory()) {
-      outcome.trajectory.Add(pose.timestamp_s, pose.world_from_cam);
-    }
-    outcome.stats = system.Stats();
-    EvaluationOptions evaluation;
-    evaluation.alignment.mode = AlignmentMode::kNone;  // the world frame itself
-    outcome.ate_m = EvaluateTrajectory(dataset.ground_truth(), outcome.trajectory, "run",
-                                       "system", evaluation)
-                        .ape_translation.rmse;
-    return outcome;
+    return RunWithOptions(dataset, options, AlignmentMode::kNone);  // the world frame itself
   };
   const RunOutcome open = run(false);
   const RunOutcome closed = run(true);
