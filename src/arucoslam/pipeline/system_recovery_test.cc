@@ -29,6 +29,7 @@ struct Scenario {
   int markers_until = 1 << 30;   // markers are detected only before this frame
   double marker_size = 0.4;      // m
   bool merge_closed_maps = true;
+  bool blocking = true;  // false: local mapping on its own thread
 };
 
 struct ScenarioRun {
@@ -48,6 +49,7 @@ ScenarioRun RunScenario(const Scenario& scenario) {
   // simply reset, not closed after new_map_after_lost_s.
   options.reset_max_keyframes = 0;
   options.merge_closed_maps = scenario.merge_closed_maps;
+  options.blocking = scenario.blocking;
   if (scenario.markers) options.marker_map = SceneMarkers(11, scenario.marker_size);
   System system(camera, options);
   std::mt19937 rng(7);
@@ -176,6 +178,19 @@ TEST(SystemRecovery, ClosedMapIsMergedIntoTheNextMapInTheWorld) {
   std::printf("first map: %d keyframes merged; world RMSE merged %.4f m, apart %.4f m\n",
               first_map_keyframes, SceneAbsoluteRmse(merged.trajectory),
               SceneAbsoluteRmse(apart.trajectory));
+}
+
+// The same with local mapping on its own thread: the merge stops and restarts it.
+TEST(SystemRecovery, ClosedMapIsMergedWithLocalMappingThreaded) {
+  Scenario scenario;
+  scenario.markers = true;
+  scenario.blocking = false;
+  const ScenarioRun run = RunScenario(scenario);
+  EXPECT_EQ(run.stats.num_map_merges, 1);
+  EXPECT_EQ(run.invariants, "");
+  EXPECT_GE(CountBefore(run.map_keyframe_times, kSceneDt * scenario.blackout_begin), 3);
+  EXPECT_EQ(run.keyframes.size(), run.map_keyframe_times.size());
+  EXPECT_LT(SceneAbsoluteRmse(run.trajectory), 0.02);
 }
 
 TEST(SystemRecovery, MapNeverAlignedStaysOutOfTheWorldTrajectory) {
