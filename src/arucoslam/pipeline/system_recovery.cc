@@ -1,5 +1,5 @@
-// System's recovery after a long loss (a new map, the old one closed as its output requires)
-// and map initialisation from two marker locations, which starts a map directly in the world.
+// System's recovery after a long loss (a new map; the old one closed, kept whole for a merge
+// when in the world) and map initialisation from two marker locations, directly in the world.
 #include <algorithm>
 #include <cmath>
 #include <numbers>
