@@ -58,8 +58,9 @@ std::string FormatPlyPoints(const std::vector<Eigen::Vector3d>& points);
 // stats.json text: {"format": "arucoslam.stats/1", "dataset", "frames": {...},
 // "tracking": {"losses", "relocalisations", ...}, "map": {..., "loops_closed",
 // "global_bundle_adjustments"}, with markers "marker_locations": {"frames_with_fix",
-// "disambiguated_by_motion", "marker_only_poses"}, "marker_fusion": {"world_alignments",
-// "drift_corrections", "whole_map_adjustments"}, "timings_ms": {stage:
+// "disambiguated_by_motion", "disambiguated_by_map_rotation", "marker_only_poses"},
+// "marker_fusion": {"world_alignments", "drift_corrections", "whole_map_adjustments",
+// "map_merges"}, "timings_ms": {stage:
 // {count, mean, median, p95, max}}, "wall_time_s", "peak_memory_bytes"}.
 std::string FormatSlamStatsJson(const SlamRunStats& stats);
 

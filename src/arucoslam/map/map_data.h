@@ -12,16 +12,16 @@
 
 namespace arucoslam {
 
-// Invariants kept by every mutating method:
-//  - keyframe.map_point_ids[i] == p  <=>  points[p].observations[keyframe.id] == i;
-//  - the covisibility weight of a-b equals the number of points observed by both;
-//  - every keyframe but the first has a spanning-tree parent.
 // New ids of another map's keyframes and points after MapData::Absorb.
 struct AbsorbedIds {
   std::map<KeyframeId, KeyframeId> keyframes;  // other's id -> id in this map
   std::map<MapPointId, MapPointId> points;
 };
 
+// Invariants kept by every mutating method:
+//  - keyframe.map_point_ids[i] == p  <=>  points[p].observations[keyframe.id] == i;
+//  - the covisibility weight of a-b equals the number of points observed by both;
+//  - every keyframe but the first has a spanning-tree parent.
 class MapData {
  public:
   // Stores a keyframe and returns its new id. Its valid map_point_ids become observations

@@ -183,13 +183,34 @@ void FillSingleMarkerAmbiguity(const std::vector<MarkerPose>& marker_poses, cons
   }
 }
 
+// Rotation of `pose` from a predicted orientation in units of the rotation gate.
+double RotationGateUnits(const Rigid3& pose, const Eigen::Quaterniond& predicted,
+                         const AmbiguityPriorGates& gates) {
+  return RotationAngle(pose.rotation.inverse() * predicted) * 180.0 / M_PI /
+         gates.max_rotation_deg;
+}
+
 // Distance of `pose` from `predicted` in units of its gate (the larger of rotation and
 // position).
 double GateUnits(const Rigid3& pose, const Rigid3& predicted, const AmbiguityPriorGates& gates) {
-  const double rotation_deg =
-      RotationAngle(pose.rotation.inverse() * predicted.rotation) * 180.0 / M_PI;
   const double position_m = (pose.translation - predicted.translation).norm();
-  return std::max(rotation_deg / gates.max_rotation_deg, position_m / gates.max_position_m);
+  return std::max(RotationGateUnits(pose, predicted.rotation, gates),
+                  position_m / gates.max_position_m);
+}
+
+// The solution of an ambiguous location within one gate unit (`units(pose)`) of a
+// prediction while the other lies beyond min_disagreement units.
+template <typename Units>
+AmbiguityChoice ChooseWithinGate(const CameraLocation& location, const AmbiguityPriorGates& gates,
+                                 const Units& units) {
+  if (!location.found || !location.alternative_world_from_cam || !gates.Check()) {
+    return AmbiguityChoice::kNone;
+  }
+  const double best = units(location.world_from_cam);
+  const double other = units(*location.alternative_world_from_cam);
+  if (best <= 1.0 && other >= gates.min_disagreement) return AmbiguityChoice::kBest;
+  if (other <= 1.0 && best >= gates.min_disagreement) return AmbiguityChoice::kAlternative;
+  return AmbiguityChoice::kNone;
 }
 
 }  // namespace
@@ -248,32 +269,17 @@ CameraLocation LocateCamera(const std::vector<MarkerDetection>& detections, cons
 AmbiguityChoice ResolveAmbiguity(const CameraLocation& location,
                                  const Rigid3& predicted_world_from_cam,
                                  const AmbiguityPriorGates& gates) {
-  if (!location.found || !location.alternative_world_from_cam || !gates.Check()) {
-    return AmbiguityChoice::kNone;
-  }
-  const double best = GateUnits(location.world_from_cam, predicted_world_from_cam, gates);
-  const double other =
-      GateUnits(*location.alternative_world_from_cam, predicted_world_from_cam, gates);
-  if (best <= 1.0 && other >= gates.min_disagreement) return AmbiguityChoice::kBest;
-  if (other <= 1.0 && best >= gates.min_disagreement) return AmbiguityChoice::kAlternative;
-  return AmbiguityChoice::kNone;
+  return ChooseWithinGate(location, gates, [&](const Rigid3& pose) {
+    return GateUnits(pose, predicted_world_from_cam, gates);
+  });
 }
 
 AmbiguityChoice ResolveAmbiguityByRotation(const CameraLocation& location,
                                            const Eigen::Quaterniond& predicted_world_from_cam,
                                            const AmbiguityPriorGates& gates) {
-  if (!location.found || !location.alternative_world_from_cam || !gates.Check()) {
-    return AmbiguityChoice::kNone;
-  }
-  const auto gate_units = [&](const Rigid3& pose) {
-    return RotationAngle(pose.rotation.inverse() * predicted_world_from_cam) * 180.0 / M_PI /
-           gates.max_rotation_deg;
-  };
-  const double best = gate_units(location.world_from_cam);
-  const double other = gate_units(*location.alternative_world_from_cam);
-  if (best <= 1.0 && other >= gates.min_disagreement) return AmbiguityChoice::kBest;
-  if (other <= 1.0 && best >= gates.min_disagreement) return AmbiguityChoice::kAlternative;
-  return AmbiguityChoice::kNone;
+  return ChooseWithinGate(location, gates, [&](const Rigid3& pose) {
+    return RotationGateUnits(pose, predicted_world_from_cam, gates);
+  });
 }
 
 std::optional<Rigid3> ChosenPose(const CameraLocation& location, AmbiguityChoice choice) {

@@ -7,6 +7,7 @@
 
 #include "arucoslam/markers/marker_pose.h"
 #include "arucoslam/optim/reprojection_error.h"
+#include "arucoslam/util/median.h"
 
 namespace arucoslam {
 
@@ -61,16 +62,6 @@ double MarkerReprojectionRmsPixels(const MarkerBundleAdjustmentProblem& problem)
   }
   return count > 0 ? std::sqrt(sum / count) : 0.0;
 }
-
-namespace {
-
-double Median(std::vector<double> values) {
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
-}
-
-}  // namespace
 
 std::optional<double> BalancedCornerSigmaPx(const MarkerBundleAdjustmentProblem& problem,
                                             double min_px, double max_px) {

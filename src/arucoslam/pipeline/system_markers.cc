@@ -146,7 +146,7 @@ AmbiguityChoice System::ResolveByMotion(const CameraLocation& location, double t
   *by_map_rotation = false;
   if (!location.alternative_world_from_cam) return AmbiguityChoice::kNone;
   AmbiguityChoice by_tracker = AmbiguityChoice::kNone;
-  bool tracker_prediction = false, fixes_prediction = false;
+  bool tracker_prediction = false, fixes_prediction = false, map_rotation_prediction = false;
   if (world_aligned_) {
     if (const std::optional<Rigid3> predicted = tracker_->PredictedPose()) {
       tracker_prediction = true;
@@ -157,12 +157,11 @@ AmbiguityChoice System::ResolveByMotion(const CameraLocation& location, double t
   } else if (options_.resolve_ambiguity_by_map_rotation && rotation_vote_.WorldFromMap() &&
              tracker_->state() == TrackingState::kTracking) {
     if (const std::optional<Rigid3> predicted = tracker_->PredictedPose()) {
-      tracker_prediction = true;
+      tracker_prediction = map_rotation_prediction = true;
       const Eigen::Quaterniond world_from_cam =
           *rotation_vote_.WorldFromMap() * predicted->rotation.inverse();
       by_tracker =
           ResolveAmbiguityByRotation(location, world_from_cam, options_.map_rotation_gates);
-      *by_map_rotation = by_tracker != AmbiguityChoice::kNone;
       ARUCOSLAM_LOG_DEBUG("t {:.3f}: ambiguous marker vs the map's voted orientation: {:.1f} / "
                           "{:.1f} deg", timestamp_s,
                           RotationAngle(location.world_from_cam.rotation.inverse() *
@@ -182,11 +181,9 @@ AmbiguityChoice System::ResolveByMotion(const CameraLocation& location, double t
     ARUCOSLAM_LOG_DEBUG("t {:.3f}: ambiguous marker, no motion prediction", timestamp_s);
   }
   if (by_tracker == AmbiguityChoice::kNone) return by_fixes;
-  if (by_fixes != AmbiguityChoice::kNone && by_fixes != by_tracker) {
-    *by_map_rotation = false;
-    return AmbiguityChoice::kNone;
-  }
-  if (by_fixes != AmbiguityChoice::kNone) *by_map_rotation = false;  // the fixes settled it too
+  if (by_fixes != AmbiguityChoice::kNone && by_fixes != by_tracker) return AmbiguityChoice::kNone;
+  // Counted as the map rotation's only when the fixes did not settle it too.
+  *by_map_rotation = map_rotation_prediction && by_fixes == AmbiguityChoice::kNone;
   return by_tracker;
 }
 

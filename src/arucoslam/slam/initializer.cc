@@ -10,6 +10,7 @@
 #include "arucoslam/feature/feature_grid.h"
 #include "arucoslam/geometry/triangulation.h"
 #include "arucoslam/geometry/two_view.h"
+#include "arucoslam/util/median.h"
 
 namespace arucoslam {
 namespace {
@@ -18,13 +19,6 @@ constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
 // Below this parallax a point is "at infinity": its depth sign is not evidence for or
 // against a motion, and it is not used as a map point.
 constexpr double kInfinityParallaxRad = 0.0063;
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const auto middle = values.begin() + values.size() / 2;
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
-}
 
 // How well one candidate motion explains the inlier correspondences.
 struct MotionEvaluation {
