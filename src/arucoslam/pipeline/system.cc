@@ -298,6 +298,7 @@ void System::Track(Frame& frame, FrameReport& report) {
     const bool stuck = fix_ && ++lost_with_markers_ >= options_.marker_reset_lost_frames;
     const bool young = static_cast<int>(map_->NumKeyframes()) <= options_.reset_max_keyframes;
     if (map_loaded_) return;  // a loaded map is kept: frames relocalise into it
+    KeepLostFrame(frame);
     if (LostTooLong(frame)) {
       ARUCOSLAM_LOG_DEBUG("frame {}: lost for {:.1f} s, starting a new map", report.index,
                           options_.new_map_after_lost_s);
@@ -312,6 +313,7 @@ void System::Track(Frame& frame, FrameReport& report) {
     return;
   }
   last_state_ = TrackingState::kTracking;
+  lost_frames_.clear();
   VoteForWorldRotation(frame);
   lost_with_markers_ = 0;
   lost_since_s_.reset();
@@ -406,7 +408,9 @@ void System::ResetMap() {
   if (kept_for_merge) closed_map_->marker_generation = marker_generation;
   poses_ = std::move(kept);
   init_reference_.reset();
-  initialisation_frames_.clear();
+  // The frames lost before the reset are the oldest the next map's backfill tries.
+  initialisation_frames_ = std::move(lost_frames_);
+  lost_frames_.clear();
   init_reference_fix_.reset();
   anchors_.clear();
   {

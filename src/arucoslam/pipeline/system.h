@@ -401,6 +401,9 @@ class System {
   // Keeps `frame` (or, without one, the reference about to be replaced) for the backfill;
   // the oldest frames go beyond max_backfill_frames.
   void KeepForBackfill(const std::optional<Frame>& frame = std::nullopt);
+  // Keeps a frame lost by the current map: when the map is reset, the next one's backfill
+  // goes on back through them (up to max_backfill_frames in all).
+  void KeepLostFrame(const Frame& frame);
   // Poses of the current map in its own frame (reference keyframes' final poses).
   std::vector<StampedPose> CurrentMapPoses(bool world_only) const;
   void StartMappingThread();
@@ -416,6 +419,7 @@ class System {
   std::unique_ptr<LocalMapper> mapper_;
   std::optional<Frame> init_reference_;
   std::vector<Frame> initialisation_frames_;  // after init_reference_, for the backfill
+  std::vector<Frame> lost_frames_;            // of the current loss, for the next backfill
   std::size_t num_frames_ = 0;
   int frames_since_keyframe_ = 0;
   TrackingState last_state_ = TrackingState::kNotInitialized;

@@ -1,6 +1,7 @@
 // System's initialisation backfill: the frames a monocular map needed to build up parallax
-// (every frame since the first initialisation reference, also replaced references) get poses
-// once the map exists, tracked backwards in time from the frame that initialised it.
+// (every frame since the first initialisation reference, also replaced references), and the
+// frames the previous map lost before it was reset, get poses once the map exists, tracked
+// backwards in time from the frame that initialised it.
 #include <algorithm>
 #include <utility>
 
@@ -9,13 +10,24 @@
 
 namespace arucoslam {
 
+namespace {
+
+void KeepAtMost(int max_frames, const Frame& frame, std::vector<Frame>* frames) {
+  if (max_frames <= 0) return;
+  frames->push_back(frame);
+  if (static_cast<int>(frames->size()) > max_frames) frames->erase(frames->begin());
+}
+
+}  // namespace
+
 void System::KeepForBackfill(const std::optional<Frame>& frame) {
   const std::optional<Frame>& kept = frame ? frame : init_reference_;
-  if (!kept || options_.max_backfill_frames <= 0) return;
-  initialisation_frames_.push_back(*kept);
-  if (static_cast<int>(initialisation_frames_.size()) > options_.max_backfill_frames) {
-    initialisation_frames_.erase(initialisation_frames_.begin());
-  }
+  if (kept) KeepAtMost(options_.max_backfill_frames, *kept, &initialisation_frames_);
+}
+
+void System::KeepLostFrame(const Frame& frame) {
+  // A frame the markers posed keeps that pose (in the world, whatever the next map does).
+  if (!fix_) KeepAtMost(options_.max_backfill_frames, frame, &lost_frames_);
 }
 
 void System::BackfillInitialization(const Frame& second, KeyframeId first_id,
@@ -23,6 +35,10 @@ void System::BackfillInitialization(const Frame& second, KeyframeId first_id,
   std::vector<Frame> frames = std::move(initialisation_frames_);
   initialisation_frames_.clear();
   if (frames.empty()) return;
+  // A replaced reference is kept when it is replaced, after the frames that followed it.
+  std::stable_sort(frames.begin(), frames.end(), [](const Frame& a, const Frame& b) {
+    return a.timestamp_s < b.timestamp_s;
+  });
   TrackerOptions tracking = options_.tracker;
   tracking.update_point_statistics = false;  // the map stays exactly as without the backfill
   Tracker backwards(*map_, tracking);

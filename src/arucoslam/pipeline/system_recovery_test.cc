@@ -30,6 +30,9 @@ struct Scenario {
   double marker_size = 0.4;      // m
   bool merge_closed_maps = true;
   bool blocking = true;  // false: local mapping on its own thread
+  // From this frame on the keypoints come from another point cloud: the first map never
+  // matches again (a loss that no relocalisation ends).
+  int scene_changes_at = 1 << 30;
 };
 
 struct ScenarioRun {
@@ -44,6 +47,9 @@ struct ScenarioRun {
 ScenarioRun RunScenario(const Scenario& scenario) {
   const CameraModel camera = SceneCamera();
   SyntheticFeatureScene scene(camera);
+  SyntheticFeatureOptions other_cloud;
+  other_cloud.seed = 2;
+  SyntheticFeatureScene changed_scene(camera, other_cloud);
   SystemOptions options;
   // The synthetic scene gives few keyframes: without this a lost map would be "young" and
   // simply reset, not closed after new_map_after_lost_s.
@@ -57,7 +63,8 @@ ScenarioRun RunScenario(const Scenario& scenario) {
   std::vector<int> truth;
   for (int t = 0; t < scenario.num_frames; ++t) {
     const Rigid3 cam_from_world = SceneWorldFromCam(t).Inverse();
-    Frame frame = scene.MakeFrame(FrameId(t), kSceneDt * t, cam_from_world, &truth);
+    SyntheticFeatureScene& seen = t < scenario.scene_changes_at ? scene : changed_scene;
+    Frame frame = seen.MakeFrame(FrameId(t), kSceneDt * t, cam_from_world, &truth);
     std::vector<MarkerDetection> detections;
     if (scenario.markers && t < scenario.markers_until) {
       detections = SceneDetections(*options.marker_map, camera, cam_from_world, rng);
@@ -117,6 +124,32 @@ TEST(SystemRecovery, KeypointsOnlyStartsANewMapAfterALongLoss) {
   for (const StampedPose& pose : run.trajectory) {
     EXPECT_EQ(SceneFrameOf(pose.timestamp_s) < scenario.blackout_begin, first_map);
   }
+  EXPECT_LT(Sim3AlignedRmse(run.trajectory), 0.018);
+}
+
+// The frames the first map lost before it was given up get poses from the next map, tracked
+// back in time from its initialisation.
+TEST(SystemRecovery, FramesLostBeforeANewMapAreTrackedBackFromIt) {
+  Scenario scenario;
+  scenario.blackout_begin = scenario.blackout_end = 0;
+  scenario.scene_changes_at = 30;
+  const ScenarioRun run = RunScenario(scenario);
+  EXPECT_EQ(run.stats.num_new_maps_after_loss, 1);
+  EXPECT_EQ(run.invariants, "");
+  // Lost when they were processed: no pose then.
+  int lost = 0;
+  for (int t = scenario.scene_changes_at; t < scenario.num_frames; ++t) {
+    if (run.reports[t].state == TrackingState::kLost) ++lost;
+  }
+  EXPECT_GE(lost, 20);  // new_map_after_lost_s at 20 Hz
+  // The output is the second map's: every frame from the change on, all consistent with the
+  // truth up to a similarity.
+  int after_change = 0;
+  for (const StampedPose& pose : run.trajectory) {
+    EXPECT_GE(SceneFrameOf(pose.timestamp_s), scenario.scene_changes_at);
+    ++after_change;
+  }
+  EXPECT_EQ(after_change, scenario.num_frames - scenario.scene_changes_at);
   EXPECT_LT(Sim3AlignedRmse(run.trajectory), 0.018);
 }
 
