@@ -132,6 +132,45 @@ TEST(System, FramesBeforeTheInitialisationAreTrackedBackwards) {
   EXPECT_LT(AlignedRmsError(run.trajectory), 0.012);
 }
 
+TEST(System, BackfillGoesBackThroughReplacedInitialisationReferences) {
+  // The camera first turns in place (pure rotation: no initialisation) far enough that the
+  // initialisation reference is replaced twice, then moves sideways. Every frame of the turn
+  // gets a pose back from the map once it exists.
+  const int turn_frames = 40;
+  const double turn_rad_per_frame = 0.8 * M_PI / 180.0;
+  const auto world_from_cam = [&](int t) {
+    const int turned = std::min(t, turn_frames);
+    const int moved = std::max(0, t - turn_frames);
+    return Rigid3(Eigen::Quaterniond(
+                      Eigen::AngleAxisd(turn_rad_per_frame * turned, Eigen::Vector3d::UnitY())),
+                  Eigen::Vector3d(0.03 * moved, 0.0, 0.0));
+  };
+  SyntheticFeatureScene scene(TestCamera());
+  System system(TestCamera(), SystemOptions());
+  std::vector<int> truth;
+  const int num_frames = turn_frames + 30;
+  int replaced = 0;
+  for (int t = 0; t < num_frames; ++t) {
+    const FrameReport report = system.ProcessFrame(
+        scene.MakeFrame(FrameId(t), 0.05 * t, world_from_cam(t).Inverse(), &truth));
+    if (t > 0 && report.message.find("100 needed") != std::string::npos) ++replaced;
+    if (t < turn_frames) EXPECT_FALSE(report.cam_from_world.has_value()) << t;
+  }
+  system.Finish();
+  EXPECT_GE(replaced, 2);
+  const std::vector<StampedPose> trajectory = system.Trajectory();
+  ASSERT_EQ(static_cast<int>(trajectory.size()), num_frames);
+  // Orientation from the map (up to its frame) against the truth: the turn is recovered.
+  for (std::size_t i = 0; i < trajectory.size(); ++i) {
+    EXPECT_EQ(std::lround(trajectory[i].timestamp_s / 0.05), static_cast<long>(i));
+    const Rigid3 first_from_cam =
+        trajectory.front().world_from_cam.Inverse() * trajectory[i].world_from_cam;
+    const Rigid3 true_first_from_cam =
+        world_from_cam(0).Inverse() * world_from_cam(static_cast<int>(i));
+    EXPECT_LT(first_from_cam.rotation.angularDistance(true_first_from_cam.rotation), 0.01) << i;
+  }
+}
+
 TEST(System, BlockingRunIsDeterministic) {
   const RunResult a = RunSynthetic(true, 40);
   const RunResult b = RunSynthetic(true, 40);
