@@ -187,8 +187,9 @@ struct SystemOptions {
   // ... and at least this median parallax of the triangulated points (degrees).
   double min_marker_init_parallax_deg = 1.0;
   // Frames between the initialisation reference and the frame that initialised the map
-  // (up to this many, the camera building up parallax) are tracked backwards against the
-  // new map and get poses too. 0: they stay without a keypoint pose.
+  // (the camera building up parallax), and before them the frames the previous map lost
+  // before it was reset, are tracked backwards against the new map and get poses too (up to
+  // this many, the newest kept). 0: they stay without a keypoint pose.
   int max_backfill_frames = 150;
 
   bool Check() const;
