@@ -130,12 +130,16 @@ ExperimentRun MarkerSlamRun(const fs::path& sequence, const fs::path& out_dir,
   run.note = fmt::format(
       "{} of {} frames with a pose ({} from markers alone), {} losses, {} marker "
       "relocalisations, {} world alignments ({} maps initialised from markers), {} new maps "
-      "after a loss ({} never aligned, left out), {} keyframes, {} map points in the last map",
+      "after a loss ({} never aligned, left out), {} keyframes, {} map points in the last map{}",
       result.stats.frames_tracked, result.stats.frames, result.timing.num_marker_only_poses,
       result.stats.losses, result.timing.num_marker_relocalizations,
       result.timing.num_world_alignments, result.timing.num_marker_initializations,
       result.timing.num_new_maps_after_loss, result.timing.num_maps_discarded,
-      result.stats.keyframes, result.stats.map_points);
+      result.stats.keyframes, result.stats.map_points,
+      options.marker_mapping.ground_plane_prior
+          ? "; ground-vehicle prior (keyframes held near one camera height and tilt in the "
+            "whole-map adjustment)"
+          : "");
   Evaluate(dataset.ground_truth(), result.trajectory, /*with_sim3=*/true, run);
   AddSlamResults(result, sequence, run.absolute, run);
   return run;
@@ -187,8 +191,10 @@ ExperimentsResult RunExperiments(const ExperimentsOptions& options) {
   }
 
   ExperimentsResult result;
+  SystemOptions run1_slam = slam;
+  if (options.ground_vehicle) run1_slam.marker_mapping.ground_plane_prior = GroundPlanePriorOptions{};
   result.runs.push_back(
-      MarkerSlamRun(with_markers, staged.path() / "run1_arucoslam", slam, options.progress));
+      MarkerSlamRun(with_markers, staged.path() / "run1_arucoslam", run1_slam, options.progress));
   result.runs.push_back(KeypointSlamRun("2: keypoints only, markers in scene", "with markers",
                                         with_markers, staged.path() / "run2_keypoints_with_markers",
                                         slam, options.progress));

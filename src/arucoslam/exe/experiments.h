@@ -27,6 +27,9 @@ struct ExperimentsOptions {
   // empty: the one shipped with arucoslam. `loop_closing` false: relocalisation only.
   std::filesystem::path vocabulary;
   bool loop_closing = true;
+  // The route is a ground vehicle's: run 1 (the one in the marker world) holds its keyframes
+  // near one camera height and tilt in the whole-map adjustment (`run --ground-vehicle`).
+  bool ground_vehicle = true;
 
   bool Check() const { return max_seconds >= 0.0 && render.Check(); }
 };

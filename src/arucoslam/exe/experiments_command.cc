@@ -58,8 +58,12 @@ void AddExperimentsCommand(CLI::App& app, int& exit_status) {
   auto no_loop_closing = std::make_shared<bool>(false);
   command->add_flag("--no-loop-closing", *no_loop_closing,
                     "the SLAM runs do not close loops (relocalisation stays on)");
-  command->callback([options, without, no_loop_closing, &exit_status] {
+  auto no_ground_vehicle = std::make_shared<bool>(false);
+  command->add_flag("--no-ground-vehicle", *no_ground_vehicle,
+                    "run 1 without the ground-vehicle prior (`run --ground-vehicle`)");
+  command->callback([options, without, no_loop_closing, no_ground_vehicle, &exit_status] {
     options->loop_closing = !*no_loop_closing;
+    options->ground_vehicle = !*no_ground_vehicle;
     if (!without->empty()) options->world_without_markers_dir = *without;
     PrintResult(RunExperiments(*options), options->out_dir);
     exit_status = kExitOk;

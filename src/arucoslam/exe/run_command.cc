@@ -30,6 +30,7 @@ struct RunArgs {
   std::string markers;  // overrides the sequence's markers.json
   double marker_size_m = 0.0;
   bool no_markers = false;
+  bool ground_vehicle = false;
   bool blocking = false;
   bool quiet = false;
   int num_features = 1000;
@@ -85,6 +86,12 @@ int RunSlam(const RunArgs& args) {
     options.marker_mapping.unknown_marker_size_m = args.marker_size_m;
   }
   const bool markers = options.marker_map.has_value();
+  if (args.ground_vehicle) {
+    if (!markers) {
+      throw InputError("--ground-vehicle", "needs markers: the plane is held in their world frame");
+    }
+    options.marker_mapping.ground_plane_prior = GroundPlanePriorOptions{};
+  }
   MapReuse reuse;
   if (!args.load_map.empty()) LoadMapForRun(args.load_map, dataset.camera(), reuse);
   reuse.localize_only = args.localize_only;
@@ -118,6 +125,10 @@ void AddRunCommand(CLI::App& app, int& exit_status) {
                 "ignore the sequence's markers.json (keypoints only). Without this flag a "
                 "markers.json in the sequence puts the run in the marker world frame, with "
                 "metric scale and marker relocalisation");
+  run->add_flag("--ground-vehicle", args->ground_vehicle,
+                "the camera rides a ground vehicle on a level floor (markers.json's world z up): "
+                "the adjustment of the whole map holds every keyframe near one height and tilt, "
+                "both estimated (needs markers)");
   run->add_option("--vocabulary", args->vocabulary,
                   "bag-of-words vocabulary for relocalisation and loop closing (default: " +
                       std::string(kDefaultVocabularyName) + " shipped with arucoslam)");

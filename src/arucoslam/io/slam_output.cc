@@ -42,7 +42,8 @@ std::string FormatSlamStatsJson(const SlamRunStats& stats) {
                  {"keyframes_inserted", stats.keyframes_inserted},
                  {"points", stats.map_points},
                  {"loops_closed", stats.loops_closed},
-                 {"global_bundle_adjustments", stats.global_bundle_adjustments}};
+                 {"global_bundle_adjustments", stats.global_bundle_adjustments},
+                 {"refined_frame_poses", stats.refined_frame_poses}};
   if (stats.markers) {
     json["marker_locations"] = {{"frames_with_fix", stats.marker_fix_frames},
                                 {"disambiguated_by_motion", stats.marker_disambiguations},

@@ -34,6 +34,7 @@ struct SlamRunStats {
   int keyframes_inserted = 0;
   int keyframes = 0;   // in the final map
   int map_points = 0;  // in the final map
+  int refined_frame_poses = 0;  // frames re-optimised against the final map
   // With a marker map: frames with a usable marker location, of which one ambiguous
   // marker settled by the motion prediction, and frames whose pose came from markers alone.
   int marker_fix_frames = 0;
@@ -57,11 +58,11 @@ struct SlamRunStats {
 std::string FormatPlyPoints(const std::vector<Eigen::Vector3d>& points);
 // stats.json text: {"format": "arucoslam.stats/1", "dataset", "frames": {...},
 // "tracking": {"losses", "relocalisations", ...}, "map": {..., "loops_closed",
-// "global_bundle_adjustments"}, with markers "marker_locations": {"frames_with_fix",
-// "disambiguated_by_motion", "disambiguated_by_map_rotation", "marker_only_poses"},
-// "marker_fusion": {"world_alignments", "drift_corrections", "whole_map_adjustments",
-// "map_merges"}, "timings_ms": {stage:
-// {count, mean, median, p95, max}}, "wall_time_s", "peak_memory_bytes"}.
+// "global_bundle_adjustments", "refined_frame_poses"}, with markers "marker_locations":
+// {"frames_with_fix", "disambiguated_by_motion", "disambiguated_by_map_rotation",
+// "marker_only_poses"}, "marker_fusion": {"world_alignments", "drift_corrections",
+// "whole_map_adjustments", "map_merges"}, "timings_ms": {stage: {count, mean, median, p95,
+// max}}, "wall_time_s", "peak_memory_bytes"}.
 std::string FormatSlamStatsJson(const SlamRunStats& stats);
 
 // Writes the four files into `dir` (which must exist), each atomically.

@@ -42,6 +42,7 @@ TEST(SlamOutput, WritesFourFilesThatReadBack) {
   stats.markers = true;
   stats.whole_map_marker_adjustments = 2;
   stats.map_merges = 1;
+  stats.refined_frame_poses = 17;
   stats.map_rotation_disambiguations = 3;
   TimingSummary summary;
   summary.count = 8;
@@ -60,6 +61,7 @@ TEST(SlamOutput, WritesFourFilesThatReadBack) {
   EXPECT_NE(json.find("\"tracked_fraction\": 0.8"), std::string::npos);
   EXPECT_NE(json.find("\"whole_map_adjustments\": 2"), std::string::npos);
   EXPECT_NE(json.find("\"map_merges\": 1"), std::string::npos);
+  EXPECT_NE(json.find("\"refined_frame_poses\": 17"), std::string::npos);
   EXPECT_NE(json.find("\"disambiguated_by_map_rotation\": 3"), std::string::npos);
   EXPECT_NE(ReadTextFile(dir / "map.ply").find("element vertex 1"), std::string::npos);
   std::filesystem::remove_all(dir);

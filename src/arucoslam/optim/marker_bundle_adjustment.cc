@@ -30,6 +30,9 @@ bool MarkerBundleAdjustmentProblem::Check(std::string* reason) const {
       return fail("marker observation " + std::to_string(i) + ": sigma <= 0");
     }
   }
+  if (ground_plane_prior && !ground_plane_prior->Check()) {
+    return fail("ground-plane prior: sigmas <= 0");
+  }
   return true;
 }
 
@@ -91,6 +94,12 @@ std::string MarkerBundleAdjustmentSummary::BriefReport() const {
       << final_marker_rms_px << " px, outliers " << num_keypoint_outliers << " keypoint / "
       << num_marker_outliers << " marker, ";
   if (corner_sigma_px > 0.0) out << "corners weighted at " << corner_sigma_px << " px, ";
+  if (ground_plane) {
+    const double tilt_deg = std::acos(std::clamp(-ground_plane->up_in_camera.y(), -1.0, 1.0)) *
+                            180.0 / 3.14159265358979323846;
+    out << "ground plane: camera height " << ground_plane->height_m << " m, tilted " << tilt_deg
+        << " deg from level, ";
+  }
   out << solve_seconds << " s (" << message << ")";
   return out.str();
 }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "arucoslam/optim/bundle_adjustment.h"
+#include "arucoslam/optim/ground_plane_error.h"
 #include "arucoslam/optim/marker_corner_error.h"
 
 namespace arucoslam {
@@ -49,6 +50,10 @@ struct MarkerBundleAdjustmentProblem {
   BundleAdjustmentProblem keypoints;
   std::vector<Marker> markers;
   std::vector<CornerObservation> marker_observations;
+  // Set: the poses are a ground vehicle's camera in a z-up world with a level floor; every
+  // pose an observation touches gets the GroundPlaneError prior, the plane (height and
+  // mounting tilt) estimated with them, starting from the poses' MeanGroundPlane.
+  std::optional<GroundPlanePriorOptions> ground_plane_prior;
 
   // Everything BundleAdjustmentProblem::Check tests, plus marker indices, sizes and sigmas.
   bool Check(std::string* reason = nullptr) const;
@@ -70,6 +75,7 @@ struct MarkerBundleAdjustmentSummary {
   std::vector<bool> marker_outliers;    // per marker observation, chi-square 8 dof
   int num_keypoint_outliers = 0;
   int num_marker_outliers = 0;
+  std::optional<GroundPlane> ground_plane;  // the estimated plane, with a ground-plane prior
   std::string message;
 
   std::string BriefReport() const;

@@ -91,11 +91,44 @@ class MarkerCornerCost : public ceres::SizedCostFunction<8, kPoseSize, kPoseSize
   double inverse_sigma_;
 };
 
+class GroundPlaneCost : public ceres::SizedCostFunction<3, kPoseSize, 1, 3> {
+ public:
+  explicit GroundPlaneCost(const GroundPlanePriorOptions& options) : error_(options) {}
+  bool Evaluate(const double* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const GroundPlane plane{parameters[1][0], Eigen::Vector3d(parameters[2])};
+    Eigen::Vector3d residual;
+    GroundPlanePoseJacobian d_pose;
+    GroundPlaneHeightJacobian d_height;
+    GroundPlaneUpJacobian d_up;
+    const bool want = jacobians != nullptr;
+    error_.Evaluate(FromBlock(parameters[0]), plane, &residual, want ? &d_pose : nullptr,
+                    want ? &d_height : nullptr, want ? &d_up : nullptr);
+    Eigen::Map<Eigen::Vector3d> whitened(residuals);
+    whitened = residual;
+    if (want && jacobians[0] != nullptr) WritePoseJacobian<3>(d_pose, 1.0, jacobians[0]);
+    if (want && jacobians[1] != nullptr) {
+      Eigen::Map<Eigen::Vector3d> j(jacobians[1]);
+      j = d_height;
+    }
+    if (want && jacobians[2] != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> j(jacobians[2]);
+      j = d_up;
+    }
+    return true;
+  }
+
+ private:
+  GroundPlaneError error_;
+};
+
 // Ceres parameter blocks of a problem; `*_used` says which ones a residual touches.
 struct Blocks {
   std::vector<PoseBlock> poses, markers;
   std::vector<std::array<double, 3>> points;
   std::vector<bool> pose_used, marker_used, point_used;
+  double ground_height = 0.0;                 // with a ground-plane prior
+  std::array<double, 3> ground_up{0, 0, 0};  // unit, on a sphere manifold
 
   explicit Blocks(const MarkerBundleAdjustmentProblem& problem) {
     for (const auto& pose : problem.keypoints.poses) poses.push_back(ToBlock(pose.cam_from_world));
@@ -161,6 +194,28 @@ void AddResiduals(const MarkerBundleAdjustmentProblem& problem, ceres::Manifold*
   }
 }
 
+// The ground-plane prior on every pose a residual uses, the plane starting from their mean.
+// False (nothing added) when no pose is used.
+bool AddGroundPlanePrior(const GroundPlanePriorOptions& options, ceres::Manifold* sphere,
+                         Blocks* blocks, ceres::Problem* ceres_problem) {
+  std::vector<Rigid3> poses;
+  for (std::size_t i = 0; i < blocks->poses.size(); ++i) {
+    if (blocks->pose_used[i]) poses.push_back(FromBlock(blocks->poses[i].data()));
+  }
+  if (poses.empty()) return false;
+  const GroundPlane start = MeanGroundPlane(poses);
+  blocks->ground_height = start.height_m;
+  blocks->ground_up = {start.up_in_camera.x(), start.up_in_camera.y(), start.up_in_camera.z()};
+  for (std::size_t i = 0; i < blocks->poses.size(); ++i) {
+    if (!blocks->pose_used[i]) continue;
+    ceres_problem->AddResidualBlock(new GroundPlaneCost(options), nullptr,
+                                    blocks->poses[i].data(), &blocks->ground_height,
+                                    blocks->ground_up.data());
+  }
+  ceres_problem->SetManifold(blocks->ground_up.data(), sphere);
+  return true;
+}
+
 void FlagOutliers(const MarkerBundleAdjustmentOptions& options,
                   const MarkerBundleAdjustmentProblem& problem,
                   MarkerBundleAdjustmentSummary* summary) {
@@ -219,6 +274,10 @@ MarkerBundleAdjustmentSummary SolveMarkerBundleAdjustment(
   ceres::HuberLoss keypoint_loss(options.solver.huber_delta_px);
   ceres::HuberLoss marker_loss(options.marker_huber_delta);
   AddResiduals(*problem, &manifold, &keypoint_loss, &marker_loss, &blocks, &ceres_problem);
+  ceres::SphereManifold<3> sphere;
+  const bool ground_plane = problem->ground_plane_prior &&
+                            AddGroundPlanePrior(*problem->ground_plane_prior, &sphere, &blocks,
+                                                &ceres_problem);
   summary.num_residual_blocks = ceres_problem.NumResidualBlocks();
   if (summary.num_residual_blocks == 0) {
     summary.success = true;
@@ -238,6 +297,10 @@ MarkerBundleAdjustmentSummary SolveMarkerBundleAdjustment(
   for (std::size_t i = 0; i < blocks.markers.size(); ++i) {
     if (blocks.marker_used[i]) ordering->AddElementToGroup(blocks.markers[i].data(), 1);
   }
+  if (ground_plane) {
+    ordering->AddElementToGroup(&blocks.ground_height, 1);
+    ordering->AddElementToGroup(blocks.ground_up.data(), 1);
+  }
   const bool has_points = ordering->NumElements() > 0 && ordering->GroupSize(0) > 0;
   solver_options.linear_solver_type = has_points ? ceres::DENSE_SCHUR : ceres::DENSE_QR;
   if (has_points) solver_options.linear_solver_ordering = ordering;
@@ -250,6 +313,9 @@ MarkerBundleAdjustmentSummary SolveMarkerBundleAdjustment(
 
   ceres_internal::CopySolverSummary(ceres_summary, &summary);
   if (summary.success) blocks.CopyTo(problem);
+  if (summary.success && ground_plane) {
+    summary.ground_plane = GroundPlane{blocks.ground_height, Eigen::Vector3d(blocks.ground_up.data())};
+  }
   summary.final_keypoint_rms_px = ReprojectionRmsPixels(problem->keypoints);
   summary.final_marker_rms_px = MarkerReprojectionRmsPixels(*problem);
   FlagOutliers(options, *problem, &summary);

@@ -46,7 +46,7 @@ MarkerBundleAdjustmentProblem MakeSyntheticMarkerScene(const SyntheticMarkerScen
   for (int i = 0; i < options.num_poses; ++i) {
     const double t = static_cast<double>(i) / (options.num_poses - 1);
     const Eigen::Vector3d position(t * length, 0.3 * std::sin(3.0 * t),
-                                   1.0 + 0.05 * std::sin(7 * t));
+                                   1.0 + options.height_wobble_m * std::sin(7 * t));
     keypoints.poses.push_back({CameraPose(position, 0.12 * std::sin(5.0 * t)), false});
   }
   for (int i = 0; i < options.num_points; ++i) {

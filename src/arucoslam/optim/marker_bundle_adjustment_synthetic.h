@@ -10,6 +10,7 @@ namespace arucoslam {
 
 struct SyntheticMarkerSceneOptions {
   int num_poses = 20;          // cameras along world +x, z-up world, camera looking along +x
+  double height_wobble_m = 0.05;  // camera height 1 m plus this times a sine along the path
   double path_length_m = 6.0;  // distance from the first to the last camera
   int num_points = 400;        // points uniformly in a box ahead of the path
   int num_markers = 4;         // markers spread from 3 m ahead of the start to past the end

@@ -30,7 +30,8 @@ bool SystemOptions::Check() const {
          max_marker_disagreement_m > 0.0 && min_frames_between_anchor_keyframes >= 0 &&
          marker_mapping.Check() && new_map_after_lost_s > 0.0 &&
          min_marker_init_baseline_m > 0.0 && min_marker_init_parallax_deg >= 0.0 &&
-         marker_search.Check() && rotation_vote.Check() && map_rotation_gates.Check();
+         marker_search.Check() && rotation_vote.Check() && map_rotation_gates.Check() &&
+         refine_min_inlier_fraction > 0.0 && refine_min_inlier_fraction <= 1.0;
 }
 
 System::System(const CameraModel& camera, const SystemOptions& options)
@@ -78,6 +79,7 @@ void System::Finish() {
   StopMappingThread();
   if (places_) places_->Finish();
   FinishMarkerMapping();
+  RefineFramePoses();
 }
 
 bool System::MapperIdle() const {
@@ -374,7 +376,19 @@ void System::RecordPose(const Frame& frame, KeyframeId reference) {
   pose.reference_scale = ReferenceScale(pose.reference);
   pose.cam_from_reference =
       reference_pose ? pose.cam_from_world * reference_pose->Inverse() : pose.cam_from_world;
-  poses_.push_back(pose);
+  if (options_.refine_frame_poses && reference_pose) {
+    for (std::size_t i = 0; i < frame.map_point_ids.size(); ++i) {
+      if (!frame.map_point_ids[i].IsValid() || (i < frame.outliers.size() && frame.outliers[i])) {
+        continue;
+      }
+      const int index = static_cast<int>(i);
+      pose.matches.push_back({frame.map_point_ids[i], frame.UndistortedPixel(index).cast<float>(),
+                              static_cast<float>(frame.SigmaPx(index))});
+    }
+    if (world_aligned_ && fix_ && fix_->known_markers_only) pose.markers = fix_->markers;
+    pose.intrinsics = PinholeIntrinsics::FromCamera(frame.camera);
+  }
+  poses_.push_back(std::move(pose));
 }
 
 void System::ResetMap() {
@@ -392,7 +406,11 @@ void System::ResetMap() {
         if (kept_for_merge) pose.closed_reference = pose.reference;
       }
       pose.reference = KeyframeId();
-      kept.push_back(pose);
+      if (!pose.closed_reference.IsValid()) {  // frozen for good: never refined
+        pose.matches = {};
+        pose.markers = {};
+      }
+      kept.push_back(std::move(pose));
     }
     return 0;
   });

@@ -191,6 +191,15 @@ struct SystemOptions {
   // before it was reset, are tracked backwards against the new map and get poses too (up to
   // this many, the newest kept). 0: they stay without a keypoint pose.
   int max_backfill_frames = 150;
+  // At Finish, after the last map adjustments, every frame tracked in the map is optimised
+  // again (motion only) against the final positions of the map points it matched when it
+  // was tracked, plus the known markers it saw, starting from its pose relative to its
+  // reference keyframe: that offset was fixed before the map's later corrections. The new
+  // pose is kept when at least refine_min_inlier_fraction of those matches (and at least the
+  // tracker's min_pose_inliers) are still in the map and stay inliers.
+  // Costs about 5 kB per frame until Finish. false: frames keep their keyframe offsets.
+  bool refine_frame_poses = true;
+  double refine_min_inlier_fraction = 0.5;
 
   bool Check() const;
 };
@@ -245,6 +254,7 @@ struct SystemStats {
   int num_marker_corrections = 0;      // pose-graph corrections of drift by markers
   int num_whole_map_marker_adjustments = 0;  // bundle adjustments of a whole map with markers
   int num_map_merges = 0;  // closed maps absorbed by a later map in the world
+  int num_refined_frame_poses = 0;  // frames re-optimised against the final map at Finish
 };
 
 struct StampedPose {
@@ -294,6 +304,11 @@ class System {
   SystemStats Stats() const;
 
  private:
+  struct FrameMatch {  // a keypoint of a tracked frame and the map point it matched
+    MapPointId point;
+    Eigen::Vector2f pixel;  // undistorted
+    float sigma_px = 1.0f;
+  };
   struct TrackedPose {
     double timestamp_s = 0.0;
     KeyframeId reference;
@@ -303,6 +318,10 @@ class System {
     bool in_world = false;  // expressed in the marker world (kept across map resets)
     // Frozen with a closed map that may still be merged: its reference keyframe there.
     KeyframeId closed_reference;
+    // What tracking matched in the frame (refine_frame_poses; emptied at Finish).
+    std::vector<FrameMatch> matches;
+    std::vector<MarkerPoseObservation> markers;  // known markers only
+    PinholeIntrinsics intrinsics;
   };
   struct MarkerAnchor {
     KeyframeId keyframe;
@@ -352,6 +371,8 @@ class System {
   Rigid3 PoseFromReference(const TrackedPose& pose, const Rigid3& reference_cam_from_world) const;
   double ReferenceScale(KeyframeId reference) const;
   void ReanchorOrphanPoses();
+  // Finish: refine_frame_poses (system_frame_refinement.cc).
+  void RefineFramePoses();
   // The map was moved as a whole (world alignment): the cached keyframe poses that
   // ReanchorOrphanPoses compares against are re-read.
   void RefreshKeyframePoseCache();

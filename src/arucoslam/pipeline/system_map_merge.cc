@@ -55,6 +55,12 @@ bool System::MergeClosedMap() {
       pose.closed_reference = KeyframeId();
       if (found == ids.keyframes.end()) continue;
       pose.reference = found->second;
+      std::vector<FrameMatch> matches;  // its points have new ids here
+      for (const FrameMatch& match : pose.matches) {
+        const auto point = ids.points.find(match.point);
+        if (point != ids.points.end()) matches.push_back({point->second, match.pixel, match.sigma_px});
+      }
+      pose.matches = std::move(matches);
       pose.cam_from_reference =
           pose.cam_from_world * data.FindKeyframe(found->second)->cam_from_world.Inverse();
       pose.reference_scale = ReferenceScale(found->second);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <set>
 #include <vector>
 
@@ -49,6 +50,10 @@ struct MarkerMapperOptions {
   double min_corner_sigma_px = 0.1;
   double max_corner_sigma_px = 4.0;
   MarkerBundleAdjustmentOptions bundle_adjustment;
+  // Set: the camera rides a ground vehicle on a level floor of the z-up world, and the
+  // adjustment of the whole map (Refine) holds every keyframe near one plane (height and
+  // mounting tilt estimated with them; GroundPlaneError). Local BA does not use it.
+  std::optional<GroundPlanePriorOptions> ground_plane_prior;
 
   bool Check() const {
     return unknown_marker_size_m >= 0.0 && marker_pose.Check() && max_initial_rms_px > 0.0 &&
@@ -56,7 +61,7 @@ struct MarkerMapperOptions {
            max_view_disagreement_fraction >= 0.0 &&
            max_pending_views >= min_consistent_views && corner_sigma_px > 0.0 &&
            min_corner_sigma_px > 0.0 && max_corner_sigma_px >= min_corner_sigma_px &&
-           bundle_adjustment.Check();
+           bundle_adjustment.Check() && (!ground_plane_prior || ground_plane_prior->Check());
   }
 };
 

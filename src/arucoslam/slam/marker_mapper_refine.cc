@@ -131,6 +131,7 @@ MarkerBundleAdjustmentProblem MarkerMapper::BuildProblem(const MapData* map,
 MarkerBundleAdjustmentSummary MarkerMapper::Refine(MapData* map) {
   ProblemIndex index;
   MarkerBundleAdjustmentProblem problem = BuildProblem(map, &index);
+  problem.ground_plane_prior = options_.ground_plane_prior;
   MarkerBundleAdjustmentSummary summary =
       SolveMarkerBundleAdjustment(options_.bundle_adjustment, &problem);
   if (!summary.success) return summary;
