@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <set>
 #include <utility>
@@ -184,6 +185,50 @@ TEST(MarkerMapperTest, WithEveryMarkerKnownRefinePullsAMisalignedMapOntoTheWorld
               scene.truth.markers[id.value].world_from_marker.translation);
   }
   EXPECT_EQ(scene.map.CheckInvariants(), "");
+}
+
+// Keyframe camera heights against the truth, metres (RMS).
+double KeyframeHeightRmse(const MappedScene& scene) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < scene.keyframes.size(); ++i) {
+    const double estimate =
+        scene.map.FindKeyframe(scene.keyframes[i])->cam_from_world.Inverse().translation.z();
+    const double truth = scene.truth.keypoints.poses[i].cam_from_world.Inverse().translation.z();
+    sum += (estimate - truth) * (estimate - truth);
+  }
+  return std::sqrt(sum / static_cast<double>(scene.keyframes.size()));
+}
+
+// A ground vehicle's map (camera at 1 m, level), one known marker near the start, a long
+// path with few noisy points: with MarkerMapperOptions::ground_plane_prior the whole-map
+// adjustment holds the far keyframes at the camera's height.
+TEST(MarkerMapperTest, GroundPlanePriorHoldsTheKeyframesOfAGroundVehicle) {
+  const auto run = [](bool ground) {
+    MappedScene scene;
+    scene.options.height_wobble_m = 0.0;
+    scene.options.num_markers = 1;
+    scene.options.path_length_m = 12.0;
+    scene.options.num_poses = 30;
+    scene.options.num_points = 120;
+    Build(scene,
+          Sim3(1.0, Eigen::Quaterniond(Eigen::AngleAxisd(0.02, Eigen::Vector3d::UnitY())),
+               Eigen::Vector3d::Zero()),
+          0.01);
+    MarkerMapperOptions options;
+    if (ground) options.ground_plane_prior = GroundPlanePriorOptions{};
+    MarkerMapper mapper(KnownMap(scene.truth), options);
+    AddAll(scene, mapper);
+    const MarkerBundleAdjustmentSummary summary = mapper.Refine(&scene.map);
+    EXPECT_TRUE(summary.success) << summary.message;
+    EXPECT_EQ(summary.ground_plane.has_value(), ground);
+    if (summary.ground_plane) EXPECT_NEAR(summary.ground_plane->height_m, 1.0, 0.01);
+    return KeyframeHeightRmse(scene);
+  };
+  const double free_m = run(false);
+  const double held_m = run(true);
+  std::printf("keyframe height RMS: %.4f m without the prior, %.4f m with it\n", free_m, held_m);
+  EXPECT_LT(held_m, 0.005);
+  EXPECT_LT(held_m, 0.5 * free_m);
 }
 
 TEST(MarkerMapperTest, AmbiguousViewsAreMappedOnceEnoughAgree) {
