@@ -193,10 +193,14 @@ TEST_F(RunCommandTest, BadInputIsOneLineAndExitTwo) {
   outcome = Run("run --dataset " + data.string() + " --out " + out.string() + " --features 5");
   EXPECT_EQ(outcome.status, 2);
   EXPECT_NE(outcome.err.find("--features"), std::string::npos) << outcome.err;
-  // The ground-vehicle prior is held in the marker world, and this sequence has no markers.
-  outcome = Run("run --dataset " + data.string() + " --out " + out.string() + " --ground-vehicle");
+  // The ground-vehicle prior is held in the marker world, and this image folder has no
+  // markers.json.
+  WriteEuRoCSensorYaml(PinholeCamera(640, 480, 500.0), dir_ / "sensor.yaml");
+  outcome = Run("run --dataset " + (dir_ / "images").string() + " --camera " +
+                (dir_ / "sensor.yaml").string() + " --out " + out.string() + " --ground-vehicle");
   EXPECT_EQ(outcome.status, 2);
   EXPECT_NE(outcome.err.find("--ground-vehicle: needs markers"), std::string::npos) << outcome.err;
+  EXPECT_EQ(CountLines(outcome.err, '\0'), 1) << outcome.err;
   EXPECT_FALSE(fs::exists(out));
   EXPECT_EQ(Run("run --out " + out.string()).status, 2);  // --dataset missing
 }
