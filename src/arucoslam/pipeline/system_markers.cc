@@ -56,6 +56,16 @@ std::string DistancesFrom(const CameraLocation& location, const Rigid3& predicte
          describe(*location.alternative_world_from_cam);
 }
 
+// The same for an orientation alone (the map's voted world rotation).
+std::string AnglesFrom(const CameraLocation& location, const Eigen::Quaterniond& world_from_cam) {
+  const auto describe = [&world_from_cam](const Rigid3& pose) {
+    return fmt::format("{:.1f} deg",
+                       RotationAngle(pose.rotation.inverse() * world_from_cam) * 180.0 / M_PI);
+  };
+  return "best " + describe(location.world_from_cam) + ", other " +
+         describe(*location.alternative_world_from_cam);
+}
+
 }  // namespace
 
 std::optional<System::MarkerFix> System::LocateWithMarkers(
@@ -162,12 +172,8 @@ AmbiguityChoice System::ResolveByMotion(const CameraLocation& location, double t
           *rotation_vote_.WorldFromMap() * predicted->rotation.inverse();
       by_tracker =
           ResolveAmbiguityByRotation(location, world_from_cam, options_.map_rotation_gates);
-      ARUCOSLAM_LOG_DEBUG("t {:.3f}: ambiguous marker vs the map's voted orientation: {:.1f} / "
-                          "{:.1f} deg", timestamp_s,
-                          RotationAngle(location.world_from_cam.rotation.inverse() *
-                                        world_from_cam) * 180.0 / M_PI,
-                          RotationAngle(location.alternative_world_from_cam->rotation.inverse() *
-                                        world_from_cam) * 180.0 / M_PI);
+      ARUCOSLAM_LOG_DEBUG("t {:.3f}: ambiguous marker vs the map's voted orientation: {}",
+                          timestamp_s, AnglesFrom(location, world_from_cam));
     }
   }
   AmbiguityChoice by_fixes = AmbiguityChoice::kNone;
