@@ -192,7 +192,9 @@ ExperimentsResult RunExperiments(const ExperimentsOptions& options) {
 
   ExperimentsResult result;
   SystemOptions run1_slam = slam;
-  if (options.ground_vehicle) run1_slam.marker_mapping.ground_plane_prior = GroundPlanePriorOptions{};
+  if (options.ground_vehicle) {
+    run1_slam.marker_mapping.ground_plane_prior = GroundPlanePriorOptions{};
+  }
   result.runs.push_back(
       MarkerSlamRun(with_markers, staged.path() / "run1_arucoslam", run1_slam, options.progress));
   result.runs.push_back(KeypointSlamRun("2: keypoints only, markers in scene", "with markers",

@@ -127,7 +127,7 @@ struct Blocks {
   std::vector<PoseBlock> poses, markers;
   std::vector<std::array<double, 3>> points;
   std::vector<bool> pose_used, marker_used, point_used;
-  double ground_height = 0.0;                 // with a ground-plane prior
+  double ground_height = 0.0;                // with a ground-plane prior
   std::array<double, 3> ground_up{0, 0, 0};  // unit, on a sphere manifold
 
   explicit Blocks(const MarkerBundleAdjustmentProblem& problem) {
@@ -208,9 +208,8 @@ bool AddGroundPlanePrior(const GroundPlanePriorOptions& options, ceres::Manifold
   blocks->ground_up = {start.up_in_camera.x(), start.up_in_camera.y(), start.up_in_camera.z()};
   for (std::size_t i = 0; i < blocks->poses.size(); ++i) {
     if (!blocks->pose_used[i]) continue;
-    ceres_problem->AddResidualBlock(new GroundPlaneCost(options), nullptr,
-                                    blocks->poses[i].data(), &blocks->ground_height,
-                                    blocks->ground_up.data());
+    ceres_problem->AddResidualBlock(new GroundPlaneCost(options), nullptr, blocks->poses[i].data(),
+                                    &blocks->ground_height, blocks->ground_up.data());
   }
   ceres_problem->SetManifold(blocks->ground_up.data(), sphere);
   return true;
@@ -275,9 +274,9 @@ MarkerBundleAdjustmentSummary SolveMarkerBundleAdjustment(
   ceres::HuberLoss marker_loss(options.marker_huber_delta);
   AddResiduals(*problem, &manifold, &keypoint_loss, &marker_loss, &blocks, &ceres_problem);
   ceres::SphereManifold<3> sphere;
-  const bool ground_plane = problem->ground_plane_prior &&
-                            AddGroundPlanePrior(*problem->ground_plane_prior, &sphere, &blocks,
-                                                &ceres_problem);
+  const bool ground_plane =
+      problem->ground_plane_prior &&
+      AddGroundPlanePrior(*problem->ground_plane_prior, &sphere, &blocks, &ceres_problem);
   summary.num_residual_blocks = ceres_problem.NumResidualBlocks();
   if (summary.num_residual_blocks == 0) {
     summary.success = true;
@@ -314,7 +313,8 @@ MarkerBundleAdjustmentSummary SolveMarkerBundleAdjustment(
   ceres_internal::CopySolverSummary(ceres_summary, &summary);
   if (summary.success) blocks.CopyTo(problem);
   if (summary.success && ground_plane) {
-    summary.ground_plane = GroundPlane{blocks.ground_height, Eigen::Vector3d(blocks.ground_up.data())};
+    summary.ground_plane =
+        GroundPlane{blocks.ground_height, Eigen::Vector3d(blocks.ground_up.data())};
   }
   summary.final_keypoint_rms_px = ReprojectionRmsPixels(problem->keypoints);
   summary.final_marker_rms_px = MarkerReprojectionRmsPixels(*problem);

@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <utility>
 #include <random>
+#include <utility>
 
 #include "arucoslam/geometry/sim3.h"
 #include "arucoslam/optim/marker_bundle_adjustment_synthetic.h"
@@ -151,8 +151,8 @@ TEST(MarkerBundleAdjustmentTest, GroundPlanePriorHoldsAGroundVehicleOnItsPlane) 
   EXPECT_LT((summary.ground_plane->up_in_camera - Eigen::Vector3d(0, -1, 0)).norm(), 0.005);
   const auto [free_height, free_tilt] = HeightAndTiltRms(free, truth);
   const auto [held_height, held_tilt] = HeightAndTiltRms(held, truth);
-  std::printf("height RMS free %.4f held %.4f m; tilt RMS free %.5f held %.5f rad\n",
-              free_height, held_height, free_tilt, held_tilt);
+  std::printf("height RMS free %.4f held %.4f m; tilt RMS free %.5f held %.5f rad\n", free_height,
+              held_height, free_tilt, held_tilt);
   EXPECT_LT(held_height, 0.005);
   EXPECT_LT(held_tilt, 0.003);
   EXPECT_LT(held_height, 0.5 * free_height);

@@ -28,10 +28,10 @@ bool SystemOptions::Check() const {
          max_alignment_rms_m > 0.0 && max_alignment_scale > 0.0 && marker_reset_lost_frames >= 1 &&
          max_realignment_anchors >= min_alignment_anchors && places.Check() &&
          max_marker_disagreement_m > 0.0 && min_frames_between_anchor_keyframes >= 0 &&
-         marker_mapping.Check() && new_map_after_lost_s > 0.0 &&
-         min_marker_init_baseline_m > 0.0 && min_marker_init_parallax_deg >= 0.0 &&
-         marker_search.Check() && rotation_vote.Check() && map_rotation_gates.Check() &&
-         refine_min_inlier_fraction > 0.0 && refine_min_inlier_fraction <= 1.0;
+         marker_mapping.Check() && new_map_after_lost_s > 0.0 && min_marker_init_baseline_m > 0.0 &&
+         min_marker_init_parallax_deg >= 0.0 && marker_search.Check() && rotation_vote.Check() &&
+         map_rotation_gates.Check() && refine_min_inlier_fraction > 0.0 &&
+         refine_min_inlier_fraction <= 1.0;
 }
 
 System::System(const CameraModel& camera, const SystemOptions& options)

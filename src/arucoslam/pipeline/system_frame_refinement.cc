@@ -40,8 +40,8 @@ void System::RefineFramePoses() {
       optimization.keypoints = options_.tracker.pose;
       optimization.keypoints.min_inliers = needed;
       // Without markers this is OptimizePose.
-      const MarkerPoseOptimizationResult result = OptimizePoseWithMarkers(
-          observations, pose.markers, start, pose.intrinsics, optimization);
+      const MarkerPoseOptimizationResult result =
+          OptimizePoseWithMarkers(observations, pose.markers, start, pose.intrinsics, optimization);
       if (!result.success || result.num_inliers < needed) continue;
       const Rigid3& refined = result.cam_from_world;
       pose.cam_from_world = refined;

@@ -58,7 +58,8 @@ bool System::MergeClosedMap() {
       std::vector<FrameMatch> matches;  // its points have new ids here
       for (const FrameMatch& match : pose.matches) {
         const auto point = ids.points.find(match.point);
-        if (point != ids.points.end()) matches.push_back({point->second, match.pixel, match.sigma_px});
+        if (point != ids.points.end())
+          matches.push_back({point->second, match.pixel, match.sigma_px});
       }
       pose.matches = std::move(matches);
       pose.cam_from_reference =

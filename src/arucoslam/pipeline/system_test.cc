@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <utility>
 #include <filesystem>
+#include <utility>
 
 #include "arucoslam/geometry/umeyama.h"
 #include "arucoslam/io/dataset_reader.h"

@@ -58,10 +58,10 @@ struct MarkerMapperOptions {
   bool Check() const {
     return unknown_marker_size_m >= 0.0 && marker_pose.Check() && max_initial_rms_px > 0.0 &&
            min_consistent_views >= 2 && max_view_disagreement_m > 0.0 &&
-           max_view_disagreement_fraction >= 0.0 &&
-           max_pending_views >= min_consistent_views && corner_sigma_px > 0.0 &&
-           min_corner_sigma_px > 0.0 && max_corner_sigma_px >= min_corner_sigma_px &&
-           bundle_adjustment.Check() && (!ground_plane_prior || ground_plane_prior->Check());
+           max_view_disagreement_fraction >= 0.0 && max_pending_views >= min_consistent_views &&
+           corner_sigma_px > 0.0 && min_corner_sigma_px > 0.0 &&
+           max_corner_sigma_px >= min_corner_sigma_px && bundle_adjustment.Check() &&
+           (!ground_plane_prior || ground_plane_prior->Check());
   }
 };
 
