@@ -72,26 +72,25 @@ int RunSlam(const RunArgs& args) {
   if (std::filesystem::exists(args.out) && !std::filesystem::is_directory(args.out)) {
     throw InputError(args.out, "exists and is not a directory");
   }
+  std::optional<std::filesystem::path> markers_path = dataset.markers_path();
+  if (!args.markers.empty()) markers_path = args.markers;
+  if (args.no_markers) markers_path.reset();
+  if (args.ground_vehicle && !markers_path) {  // before the vocabulary's load: fail fast
+    throw InputError("--ground-vehicle", "needs markers: the plane is held in their world frame");
+  }
   const std::filesystem::path vocabulary =
       args.vocabulary.empty() ? DefaultVocabularyPath() : std::filesystem::path(args.vocabulary);
   SystemOptions options =
       DefaultRunOptions(args.blocking, std::make_shared<const Vocabulary>(Vocabulary::Load(vocabulary)),
                         !args.no_loop_closing);
   options.extractor.num_features = args.num_features;
-  std::optional<std::filesystem::path> markers_path = dataset.markers_path();
-  if (!args.markers.empty()) markers_path = args.markers;
-  if (markers_path && !args.no_markers) {
+  if (markers_path) {
     options.marker_map = ReadMarkerMapJson(*markers_path);
     options.detector.dictionary = options.marker_map->dictionary;
     options.marker_mapping.unknown_marker_size_m = args.marker_size_m;
   }
   const bool markers = options.marker_map.has_value();
-  if (args.ground_vehicle) {
-    if (!markers) {
-      throw InputError("--ground-vehicle", "needs markers: the plane is held in their world frame");
-    }
-    options.marker_mapping.ground_plane_prior = GroundPlanePriorOptions{};
-  }
+  if (args.ground_vehicle) options.marker_mapping.ground_plane_prior = GroundPlanePriorOptions{};
   MapReuse reuse;
   if (!args.load_map.empty()) LoadMapForRun(args.load_map, dataset.camera(), reuse);
   reuse.localize_only = args.localize_only;

@@ -95,8 +95,8 @@ std::string MarkerBundleAdjustmentSummary::BriefReport() const {
       << num_marker_outliers << " marker, ";
   if (corner_sigma_px > 0.0) out << "corners weighted at " << corner_sigma_px << " px, ";
   if (ground_plane) {
-    const double tilt_deg = std::acos(std::clamp(-ground_plane->up_in_camera.y(), -1.0, 1.0)) *
-                            180.0 / 3.14159265358979323846;
+    const double tilt_deg =
+        std::acos(std::clamp(-ground_plane->up_in_camera.y(), -1.0, 1.0)) * 180.0 / M_PI;
     out << "ground plane: camera height " << ground_plane->height_m << " m, tilted " << tilt_deg
         << " deg from level, ";
   }

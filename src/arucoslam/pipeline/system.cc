@@ -386,7 +386,6 @@ void System::RecordPose(const Frame& frame, KeyframeId reference) {
                               static_cast<float>(frame.SigmaPx(index))});
     }
     if (world_aligned_ && fix_ && fix_->known_markers_only) pose.markers = fix_->markers;
-    pose.intrinsics = PinholeIntrinsics::FromCamera(frame.camera);
   }
   poses_.push_back(std::move(pose));
 }

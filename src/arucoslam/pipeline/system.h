@@ -322,7 +322,6 @@ class System {
     // What tracking matched in the frame (refine_frame_poses; emptied at Finish).
     std::vector<FrameMatch> matches;
     std::vector<MarkerPoseObservation> markers;  // known markers only
-    PinholeIntrinsics intrinsics;
   };
   struct MarkerAnchor {
     KeyframeId keyframe;

@@ -14,6 +14,7 @@ void System::RefineFramePoses() {
   if (!options_.refine_frame_poses) return;
   const Stopwatch watch;
   int num_refined = 0, num_candidates = 0;
+  const PinholeIntrinsics intrinsics = PinholeIntrinsics::FromCamera(camera_);
   map_->Read([&](const MapData& data) {
     std::vector<PoseObservation> observations;
     for (TrackedPose& pose : poses_) {
@@ -41,7 +42,7 @@ void System::RefineFramePoses() {
       optimization.keypoints.min_inliers = needed;
       // Without markers this is OptimizePose.
       const MarkerPoseOptimizationResult result =
-          OptimizePoseWithMarkers(observations, pose.markers, start, pose.intrinsics, optimization);
+          OptimizePoseWithMarkers(observations, pose.markers, start, intrinsics, optimization);
       if (!result.success || result.num_inliers < needed) continue;
       const Rigid3& refined = result.cam_from_world;
       pose.cam_from_world = refined;
