@@ -21,11 +21,12 @@ void WaitIgnoringErrors(MarkerDetectorWorker& worker) {
 bool SystemOptions::Check() const {
   return extractor.Check() && initializer.Check() && initial_map.Check() && tracker.Check() &&
          keyframes.Check() && mapper.Check() && mapper_queue_capacity >= 1 &&
-         max_initialization_gap_s > 0.0 && reset_max_keyframes >= 0 && detector.Check() &&
-         locator.Check() && alignment.Check() && max_marker_rms_px > 0.0 &&
-         max_marker_distance_sides > 0.0 && ambiguity_gates.Check() && fix_motion.Check() &&
-         min_alignment_anchors >= 2 && min_alignment_baseline_m >= 0.0 &&
-         max_alignment_rms_m > 0.0 && max_alignment_scale > 0.0 && marker_reset_lost_frames >= 1 &&
+         max_initialization_gap_s > 0.0 && reset_max_keyframes >= 0 &&
+         synchronous_young_map_keyframes >= 0 && detector.Check() && locator.Check() &&
+         alignment.Check() && max_marker_rms_px > 0.0 && max_marker_distance_sides > 0.0 &&
+         ambiguity_gates.Check() && fix_motion.Check() && min_alignment_anchors >= 2 &&
+         min_alignment_baseline_m >= 0.0 && max_alignment_rms_m > 0.0 &&
+         max_alignment_scale > 0.0 && marker_reset_lost_frames >= 1 &&
          max_realignment_anchors >= min_alignment_anchors && places.Check() &&
          max_marker_disagreement_m > 0.0 && min_frames_between_anchor_keyframes >= 0 &&
          marker_mapping.Check() && new_map_after_lost_s > 0.0 && min_marker_init_baseline_m > 0.0 &&
@@ -59,10 +60,20 @@ System::~System() { Finish(); }
 void System::StartMappingThread() {
   if (options_.blocking) return;
   queue_ = std::make_unique<BoundedQueue<KeyframeId>>(options_.mapper_queue_capacity);
+  keyframes_queued_ = 0;
+  {
+    std::lock_guard lock(mapped_mutex_);
+    keyframes_mapped_ = 0;
+  }
   mapping_thread_ = std::thread([this] {
     while (const std::optional<KeyframeId> keyframe = queue_->Pop()) {
       MapKeyframe(*keyframe);
       mapping_busy_ = false;
+      {
+        std::lock_guard lock(mapped_mutex_);
+        ++keyframes_mapped_;
+      }
+      mapped_.notify_all();
     }
   });
 }
@@ -80,6 +91,11 @@ void System::Finish() {
   if (places_) places_->Finish();
   FinishMarkerMapping();
   RefineFramePoses();
+}
+
+void System::WaitForMapping() {
+  std::unique_lock lock(mapped_mutex_);
+  mapped_.wait(lock, [this] { return keyframes_mapped_ >= keyframes_queued_; });
 }
 
 bool System::MapperIdle() const {
@@ -356,7 +372,12 @@ void System::MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& rep
     pending_keyframe_ = keyframe;  // mapped once the frame's tracking time is recorded
   } else {
     mapping_busy_ = true;
-    queue_->Push(keyframe);
+    if (queue_->Push(keyframe)) {
+      ++keyframes_queued_;
+      if (static_cast<int>(map_->NumKeyframes()) <= options_.synchronous_young_map_keyframes) {
+        WaitForMapping();
+      }
+    }
   }
   AddAnchor(keyframe, fix_);
   MaybeAlignWorld(&frame);

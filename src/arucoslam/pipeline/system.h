@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 
 #include <atomic>
+#include <condition_variable>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -51,6 +52,12 @@ struct SystemOptions {
   // ProcessImage returns (deterministic). false: local mapping runs on its own thread.
   bool blocking = true;
   int mapper_queue_capacity = 3;  // keyframes waiting for the mapping thread
+  // Threaded mode: while the map holds at most this many keyframes, tracking waits until
+  // each new keyframe is mapped before it takes the next frame, as in blocking mode. A young
+  // map tracked ahead of its local BA drifts in scale: a map started after a loss on the
+  // demo sequence ended its first local BAs at 4-7 px RMS and lost four fifths of its scale
+  // before it saw a marker (blocking: 1.4-3.7 px). 0: tracking never waits.
+  int synchronous_young_map_keyframes = 20;
   // The initialisation reference frame is replaced when the current frame is more than this
   // many seconds later (a reference is also replaced when too few matches are left). Long
   // enough for a vehicle that starts from rest to build up parallax.
@@ -518,6 +525,14 @@ class System {
   std::unique_ptr<BoundedQueue<KeyframeId>> queue_;
   std::thread mapping_thread_;
   std::atomic<bool> mapping_busy_{false};
+  // Threaded mode: keyframes pushed to queue_ and keyframes the mapping thread finished,
+  // both counted from StartMappingThread (synchronous_young_map_keyframes).
+  std::size_t keyframes_queued_ = 0;
+  std::size_t keyframes_mapped_ = 0;  // guarded by mapped_mutex_
+  std::mutex mapped_mutex_;
+  std::condition_variable mapped_;
+  // Waits until the mapping thread has mapped every keyframe queued so far.
+  void WaitForMapping();
   bool finished_ = false;
 
   mutable std::mutex stats_mutex_;

@@ -222,6 +222,32 @@ TEST(System, ThreadedRunTracksSyntheticSequence) {
   EXPECT_LT(AlignedRmsError(run.trajectory), 0.024);
 }
 
+TEST(System, ThreadedRunMapsAYoungMapsKeyframesBeforeTheNextFrame) {
+  // While the map holds at most synchronous_young_map_keyframes keyframes, tracking waits
+  // for each new keyframe's local mapping: when ProcessFrame returns, every keyframe it
+  // inserted is mapped (the two of the initial map are not mapped by local mapping).
+  SyntheticFeatureScene scene(TestCamera());
+  SystemOptions options;
+  options.blocking = false;
+  options.synchronous_young_map_keyframes = 1000;
+  System system(TestCamera(), options);
+  std::vector<int> truth;
+  int checked = 0;
+  for (int t = 0; t < 80; ++t) {
+    const FrameReport report = system.ProcessFrame(
+        scene.MakeFrame(FrameId(t), 0.05 * t, WorldFromCam(t).Inverse(), &truth));
+    const SystemStats stats = system.Stats();
+    if (!report.new_keyframe || report.initialized_map) continue;
+    EXPECT_EQ(static_cast<int>(stats.local_mapping_ms.Count()),
+              stats.num_keyframes_inserted - 2 * stats.num_initializations)
+        << "frame " << t;
+    ++checked;
+  }
+  EXPECT_GE(checked, 5);  // keyframes were inserted after the initial map
+  system.Finish();
+  EXPECT_LT(AlignedRmsError(system.Trajectory()), 0.024);
+}
+
 TEST(System, PlaceRecognitionAlongsideThreadedMappingKeepsTheRunIntact) {
   // Keyframes go through the database and loop detection on their own thread; the route
   // never comes back, so nothing may be closed and the result matches the plain run.
