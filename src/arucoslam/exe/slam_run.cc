@@ -31,6 +31,7 @@ SlamRunStats MakeStats(const std::string& dataset_label, const Dataset& dataset,
   out.frames = stats.num_frames;
   out.frames_tracked = stats.num_tracked;
   out.frames_lost = stats.num_lost;
+  out.inconsistent_poses = stats.num_inconsistent_poses;
   out.losses = stats.num_losses;
   // From the place database, marker poses and keyframe matches in a loaded map.
   out.relocalisations = stats.places.num_relocalizations + stats.num_marker_relocalizations +

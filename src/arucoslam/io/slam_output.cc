@@ -27,12 +27,13 @@ std::string FormatSlamStatsJson(const SlamRunStats& stats) {
   json["layout"] = stats.layout;
   json["blocking"] = stats.blocking;
   json["markers"] = stats.markers;
-  json["frames"] = {{"total", stats.frames},
-                    {"tracked", stats.frames_tracked},
-                    {"lost", stats.frames_lost},
-                    {"tracked_fraction",
-                     stats.frames > 0 ? static_cast<double>(stats.frames_tracked) / stats.frames
-                                      : 0.0}};
+  json["frames"] = {
+      {"total", stats.frames},
+      {"tracked", stats.frames_tracked},
+      {"lost", stats.frames_lost},
+      {"left_out", stats.inconsistent_poses},
+      {"tracked_fraction",
+       stats.frames > 0 ? static_cast<double>(stats.frames_tracked) / stats.frames : 0.0}};
   json["tracking"] = {{"losses", stats.losses},
                       {"relocalisations", stats.relocalisations},
                       {"initialization_attempts", stats.initialization_attempts},

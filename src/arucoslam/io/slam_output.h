@@ -24,6 +24,7 @@ struct SlamRunStats {
   int frames = 0;
   int frames_tracked = 0;  // frames with a pose
   int frames_lost = 0;
+  int inconsistent_poses = 0;  // tracked, left out of the trajectory: off their keyframes
   int losses = 0;          // transitions tracking -> lost
   int relocalisations = 0;
   int loops_closed = 0;
@@ -56,7 +57,7 @@ struct SlamRunStats {
 
 // ASCII PLY with one vertex (x y z, double) per point.
 std::string FormatPlyPoints(const std::vector<Eigen::Vector3d>& points);
-// stats.json text: {"format": "arucoslam.stats/1", "dataset", "frames": {...},
+// stats.json text: {"format": "arucoslam.stats/1", "dataset", "frames": {..., "left_out"},
 // "tracking": {"losses", "relocalisations", ...}, "map": {..., "loops_closed",
 // "global_bundle_adjustments", "refined_frame_poses"}, with markers "marker_locations":
 // {"frames_with_fix", "disambiguated_by_motion", "disambiguated_by_map_rotation",

@@ -43,6 +43,7 @@ TEST(SlamOutput, WritesFourFilesThatReadBack) {
   stats.whole_map_marker_adjustments = 2;
   stats.map_merges = 1;
   stats.refined_frame_poses = 17;
+  stats.inconsistent_poses = 5;
   stats.map_rotation_disambiguations = 3;
   TimingSummary summary;
   summary.count = 8;
@@ -62,6 +63,7 @@ TEST(SlamOutput, WritesFourFilesThatReadBack) {
   EXPECT_NE(json.find("\"whole_map_adjustments\": 2"), std::string::npos);
   EXPECT_NE(json.find("\"map_merges\": 1"), std::string::npos);
   EXPECT_NE(json.find("\"refined_frame_poses\": 17"), std::string::npos);
+  EXPECT_NE(json.find("\"left_out\": 5"), std::string::npos);
   EXPECT_NE(json.find("\"disambiguated_by_map_rotation\": 3"), std::string::npos);
   EXPECT_NE(ReadTextFile(dir / "map.ply").find("element vertex 1"), std::string::npos);
   std::filesystem::remove_all(dir);

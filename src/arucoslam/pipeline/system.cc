@@ -21,7 +21,7 @@ void WaitIgnoringErrors(MarkerDetectorWorker& worker) {
 bool SystemOptions::Check() const {
   return extractor.Check() && initializer.Check() && initial_map.Check() && tracker.Check() &&
          keyframes.Check() && mapper.Check() && mapper_queue_capacity >= 1 &&
-         max_initialization_gap_s > 0.0 && reset_max_keyframes >= 0 &&
+         max_initialization_gap_s > 0.0 && reset_max_keyframes >= 0 && pose_consistency.Check() &&
          synchronous_young_map_keyframes >= 0 && detector.Check() && locator.Check() &&
          alignment.Check() && max_marker_rms_px > 0.0 && max_marker_distance_sides > 0.0 &&
          ambiguity_gates.Check() && fix_motion.Check() && min_alignment_anchors >= 2 &&
@@ -91,6 +91,14 @@ void System::Finish() {
   if (places_) places_->Finish();
   FinishMarkerMapping();
   RefineFramePoses();
+  int num_inconsistent = 0;
+  CheckedTrajectory(&num_inconsistent);
+  if (num_inconsistent > 0) {
+    ARUCOSLAM_LOG_DEBUG("{} frames left out of the trajectory: off their keyframes' path",
+                        num_inconsistent);
+  }
+  std::lock_guard lock(stats_mutex_);
+  stats_.num_inconsistent_poses = num_inconsistent;
 }
 
 void System::WaitForMapping() {
@@ -468,10 +476,17 @@ void System::ResetMap() {
   ++stats_.num_resets;
 }
 
-std::vector<StampedPose> System::Trajectory() const {
-  if (options_.marker_map) return CurrentMapPoses(/*world_only=*/true);
-  if (map_->NumKeyframes() >= biggest_closed_keyframes_) return CurrentMapPoses(false);
-  return biggest_closed_poses_;
+std::vector<StampedPose> System::Trajectory() const { return CheckedTrajectory(nullptr); }
+
+std::vector<StampedPose> System::CheckedTrajectory(int* num_dropped) const {
+  if (num_dropped != nullptr) *num_dropped = 0;
+  if (!options_.marker_map && map_->NumKeyframes() < biggest_closed_keyframes_) {
+    return biggest_closed_poses_;
+  }
+  std::vector<StampedPose> poses = CurrentMapPoses(/*world_only=*/options_.marker_map.has_value());
+  // A loaded map's keyframes were timed in another run: they do not bracket these frames.
+  if (!options_.drop_inconsistent_poses || map_loaded_) return poses;
+  return DropPosesOffTheirKeyframes(poses, KeyframePoses(), options_.pose_consistency, num_dropped);
 }
 
 std::vector<StampedPose> System::CurrentMapPoses(bool world_only) const {
