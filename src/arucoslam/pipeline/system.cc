@@ -32,7 +32,9 @@ bool SystemOptions::Check() const {
          marker_mapping.Check() && new_map_after_lost_s > 0.0 && min_marker_init_baseline_m > 0.0 &&
          min_marker_init_parallax_deg >= 0.0 && marker_search.Check() && rotation_vote.Check() &&
          map_rotation_gates.Check() && refine_min_inlier_fraction > 0.0 &&
-         refine_min_inlier_fraction <= 1.0;
+         refine_min_inlier_fraction <= 1.0 && bridge_motion.Check() &&
+         bridge_position_sigma_m > 0.0 && bridge_position_sigma_per_s >= 0.0 &&
+         bridge_rotation_sigma_rad > 0.0 && bridge_rotation_sigma_per_s >= 0.0;
 }
 
 System::System(const CameraModel& camera, const SystemOptions& options)
@@ -269,6 +271,7 @@ void System::FinishInitialization(Frame& first, Frame& frame, KeyframeId first_i
     places_->KeyframeMapped(first_id);
     places_->KeyframeMapped(second_id);
   }
+  AddBridgePrior(first_id, first.timestamp_s);
   AddAnchor(first_id, init_reference_fix_);
   AddAnchor(second_id, fix_);
   init_reference_fix_.reset();
@@ -462,11 +465,13 @@ void System::ResetMap() {
   {
     std::lock_guard lock(keyframe_fixes_mutex_);
     keyframe_fixes_.clear();
+    merged_bridge_priors_.clear();
   }
   next_alignment_anchors_ = 0;
   world_aligned_ = false;
   rotation_vote_.Clear();
   absorbed_keyframes_.clear();
+  bridge_priors_.clear();
   lost_with_markers_ = 0;
   lost_since_s_.reset();
   last_state_ = TrackingState::kNotInitialized;

@@ -311,7 +311,7 @@ void System::MaybeAlignWorld(Frame* frame) {
     frame->cam_from_world = to_world(*frame->cam_from_world);
   }
   next_alignment_anchors_ = 2 * static_cast<int>(anchors.size());
-  MergeClosedMap();
+  if (MergeClosedMap()) CorrectAcrossBridge();
   mapping_busy_ = false;
   StartMappingThread();
   ARUCOSLAM_LOG_DEBUG("keypoint map {}aligned to the marker world: scale {:.4f}, {} of {} "

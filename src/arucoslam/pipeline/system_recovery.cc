@@ -89,6 +89,7 @@ bool System::CloseMap() {
   }
   // Before its poses are frozen: the whole map against every marker it saw.
   AdjustWholeMapWithMarkers("map closed");
+  RememberMotionAtClose();
   ClosedMap closed;
   closed.output_keyframes_before = closed_keyframes_.size();
   closed.output_points_before = closed_points_.size();

@@ -27,8 +27,10 @@ struct Scenario {
   int blackout_end = 60;
   bool markers = false;          // a marker map is given
   int markers_until = 1 << 30;   // markers are detected only before this frame
+  int markers_again_from = 1 << 30;  // ... and from this frame on
   double marker_size = 0.4;      // m
   bool merge_closed_maps = true;
+  bool bridge_tracking_gaps = true;
   bool blocking = true;  // false: local mapping on its own thread
   // From this frame on the keypoints come from another point cloud: the first map never
   // matches again (a loss that no relocalisation ends).
@@ -55,6 +57,7 @@ ScenarioRun RunScenario(const Scenario& scenario) {
   // simply reset, not closed after new_map_after_lost_s.
   options.reset_max_keyframes = 0;
   options.merge_closed_maps = scenario.merge_closed_maps;
+  options.bridge_tracking_gaps = scenario.bridge_tracking_gaps;
   options.blocking = scenario.blocking;
   if (scenario.markers) options.marker_map = SceneMarkers(11, scenario.marker_size);
   System system(camera, options);
@@ -66,7 +69,7 @@ ScenarioRun RunScenario(const Scenario& scenario) {
     SyntheticFeatureScene& seen = t < scenario.scene_changes_at ? scene : changed_scene;
     Frame frame = seen.MakeFrame(FrameId(t), kSceneDt * t, cam_from_world, &truth);
     std::vector<MarkerDetection> detections;
-    if (scenario.markers && t < scenario.markers_until) {
+    if (scenario.markers && (t < scenario.markers_until || t >= scenario.markers_again_from)) {
       detections = SceneDetections(*options.marker_map, camera, cam_from_world, rng);
     }
     if (t >= scenario.blackout_begin && t < scenario.blackout_end) {
@@ -211,6 +214,52 @@ TEST(SystemRecovery, ClosedMapIsMergedIntoTheNextMapInTheWorld) {
   std::printf("first map: %d keyframes merged; world RMSE merged %.4f m, apart %.4f m\n",
               first_map_keyframes, SceneAbsoluteRmse(merged.trajectory),
               SceneAbsoluteRmse(apart.trajectory));
+}
+
+// Position RMSE of the poses in frames [begin, end), no alignment, metres.
+double WindowRmse(const std::vector<StampedPose>& trajectory, int begin, int end, int* count) {
+  std::vector<StampedPose> window;
+  for (const StampedPose& pose : trajectory) {
+    const int t = SceneFrameOf(pose.timestamp_s);
+    if (t >= begin && t < end) window.push_back(pose);
+  }
+  *count = static_cast<int>(window.size());
+  return SceneAbsoluteRmse(window);
+}
+
+// A map started after a loss with no marker in view is put in the world by the markers it
+// meets later; once it has absorbed the closed map, the closed map's motion before the gap
+// ties its start too (the bridge) in a pose-graph correction. Here the keypoints alone keep
+// the new map right (the end-of-run adjustment restores it even from a bridge 0.5 m off):
+// the bridge must leave it so. Where it helps (a young map drifting in a low-texture turn):
+// the demo sequence, figures at SystemOptions::bridge_tracking_gaps.
+TEST(SystemRecovery, MapAfterAGapIsBridgedToTheClosedMap) {
+  Scenario scenario;
+  scenario.markers = true;
+  scenario.markers_until = scenario.blackout_begin;
+  scenario.markers_again_from = 85;
+  const ScenarioRun bridged = RunScenario(scenario);
+  scenario.bridge_tracking_gaps = false;
+  const ScenarioRun unbridged = RunScenario(scenario);
+  EXPECT_EQ(bridged.stats.num_map_merges, 1);
+  EXPECT_EQ(bridged.stats.num_bridged_gaps, 1);
+  EXPECT_EQ(unbridged.stats.num_bridged_gaps, 0);
+  EXPECT_EQ(bridged.invariants, "");
+  int bridged_count = 0, unbridged_count = 0;
+  const double bridged_rmse = WindowRmse(bridged.trajectory, scenario.blackout_end,
+                                         scenario.markers_again_from, &bridged_count);
+  const double unbridged_rmse = WindowRmse(unbridged.trajectory, scenario.blackout_end,
+                                           scenario.markers_again_from, &unbridged_count);
+  std::printf(
+      "frames between the gap and the markers: bridged %d poses %.4f m, unbridged %d "
+      "poses %.4f m; whole run %.4f / %.4f m\n",
+      bridged_count, bridged_rmse, unbridged_count, unbridged_rmse,
+      SceneAbsoluteRmse(bridged.trajectory), SceneAbsoluteRmse(unbridged.trajectory));
+  // Measured 25 poses, 4.3 mm both; whole run 9.7 / 9.6 mm.
+  EXPECT_EQ(bridged_count, scenario.markers_again_from - scenario.blackout_end);
+  EXPECT_LT(bridged_rmse, 0.01);
+  EXPECT_LT(bridged_rmse, unbridged_rmse + 0.002);
+  EXPECT_LT(SceneAbsoluteRmse(bridged.trajectory), 0.02);
 }
 
 // The same with local mapping on its own thread: the merge stops and restarts it.

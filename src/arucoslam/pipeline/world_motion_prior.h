@@ -33,6 +33,10 @@ class WorldMotionPrior {
   // velocity and angular rate between the oldest fix in the span and it; nullopt when the
   // fixes are too old or span too little time.
   std::optional<Rigid3> Predict(double timestamp_s) const;
+  // Time of the newest fix (nullopt: none).
+  std::optional<double> NewestTimestamp() const {
+    return fixes_.empty() ? std::nullopt : std::optional<double>(fixes_.back().timestamp_s);
+  }
 
  private:
   struct Fix {

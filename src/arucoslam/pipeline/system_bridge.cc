@@ -1,0 +1,73 @@
+// System's bridge over a tracking gap: the world-aligned map closed after a loss predicts,
+// from the camera's motion at its end, where the next map's first keyframe is; once both maps
+// are merged in the world, that prediction ties the new map's start in the pose graph.
+#include <vector>
+
+#include "arucoslam/pipeline/system.h"
+#include "arucoslam/util/logging.h"
+
+namespace arucoslam {
+
+void System::RememberMotionAtClose() {
+  motion_at_close_.Clear();
+  if (!options_.bridge_tracking_gaps) return;
+  // Frames off their keyframes (a plain wall before the loss) would bend the velocity.
+  const std::vector<StampedPose> poses = DropPosesOffTheirKeyframes(
+      CurrentMapPoses(/*world_only=*/true), KeyframePoses(), options_.pose_consistency);
+  for (const StampedPose& pose : poses) motion_at_close_.Add(pose.timestamp_s, pose.world_from_cam);
+}
+
+void System::AddBridgePrior(KeyframeId keyframe, double timestamp_s) {
+  if (!options_.bridge_tracking_gaps || !closed_map_ || world_aligned_) return;
+  const std::optional<Rigid3> predicted = motion_at_close_.Predict(timestamp_s);
+  if (!predicted) return;
+  const double gap_s = timestamp_s - *motion_at_close_.NewestTimestamp();
+  const double position_sigma =
+      options_.bridge_position_sigma_m + options_.bridge_position_sigma_per_s * gap_s;
+  const double rotation_sigma =
+      options_.bridge_rotation_sigma_rad + options_.bridge_rotation_sigma_per_s * gap_s;
+  KeyframePosePrior prior;
+  prior.keyframe = keyframe;
+  prior.world_from_cam = *predicted;
+  prior.information = Matrix6d::Zero();
+  prior.information.topLeftCorner<3, 3>().diagonal().setConstant(1.0 /
+                                                                 (position_sigma * position_sigma));
+  prior.information.bottomRightCorner<3, 3>().diagonal().setConstant(
+      1.0 / (rotation_sigma * rotation_sigma));
+  bridge_priors_.push_back(prior);
+  ARUCOSLAM_LOG_DEBUG(
+      "keyframe {}: bridged over {:.2f} s from the closed map (sigma {:.2f} m, "
+      "{:.2f} rad)",
+      keyframe.value, gap_s, position_sigma, rotation_sigma);
+}
+
+std::vector<KeyframePosePrior> System::CorrectionPriors() const {
+  std::vector<KeyframePosePrior> priors = KnownMarkerPriors();
+  std::lock_guard lock(keyframe_fixes_mutex_);
+  priors.insert(priors.end(), merged_bridge_priors_.begin(), merged_bridge_priors_.end());
+  return priors;
+}
+
+bool System::CorrectAcrossBridge() {
+  if (bridge_priors_.empty()) return false;
+  {
+    // From here on every correction keeps them (loops run on the places' thread).
+    std::lock_guard lock(keyframe_fixes_mutex_);
+    merged_bridge_priors_ = std::move(bridge_priors_);
+  }
+  bridge_priors_.clear();
+  if (places_) places_->MapMovedExternally();
+  const EssentialGraphResult result = OptimizeEssentialGraph(
+      *map_, KeyframeId(), {}, {}, CorrectionPriors(), options_.marker_correction_graph);
+  ARUCOSLAM_LOG_DEBUG(
+      "merged map corrected across the tracking gap over {} keyframes with {} "
+      "priors: {}",
+      result.num_keyframes, result.num_priors, result.summary.BriefReport());
+  if (!result.applied) return false;
+  if (places_) places_->RecordScaleChanges(result.scale_changes);
+  std::lock_guard lock(stats_mutex_);
+  ++stats_.num_bridged_gaps;
+  return true;
+}
+
+}  // namespace arucoslam
