@@ -37,7 +37,8 @@ EssentialGraph Build(const MapData& data, KeyframeId fixed_keyframe,
                      const std::vector<LoopConstraint>& loops,
                      const std::map<KeyframeId, Sim3>& corrected,
                      const std::vector<KeyframePosePrior>& priors,
-                     const EssentialGraphOptions& options) {
+                     const EssentialGraphOptions& options,
+                     const std::set<KeyframeId>& held_keyframes) {
   EssentialGraph graph;
   const Matrix7d information = EdgeInformation(options);
   for (const auto& [id, keyframe] : data.keyframes()) {
@@ -46,7 +47,8 @@ EssentialGraph Build(const MapData& data, KeyframeId fixed_keyframe,
     graph.uncorrected.emplace_back(keyframe.cam_from_world);
     const auto it = corrected.find(id);
     graph.problem.nodes.push_back(
-        {it != corrected.end() ? it->second : Sim3(keyframe.cam_from_world), id == fixed_keyframe});
+        {it != corrected.end() ? it->second : Sim3(keyframe.cam_from_world),
+         id == fixed_keyframe || held_keyframes.count(id) != 0});
   }
   auto relative = [&](KeyframeId from, KeyframeId to) {
     return graph.uncorrected[graph.index.at(to)] *
@@ -156,14 +158,15 @@ EssentialGraphResult OptimizeEssentialGraph(Map& map, KeyframeId fixed_keyframe,
                                             const std::vector<LoopConstraint>& loops,
                                             const std::map<KeyframeId, Sim3>& corrected,
                                             const std::vector<KeyframePosePrior>& priors,
-                                            const EssentialGraphOptions& options) {
+                                            const EssentialGraphOptions& options,
+                                            const std::set<KeyframeId>& held_keyframes) {
   if (!options.Check()) {
     EssentialGraphResult result;
     result.summary.message = "invalid options";
     return result;
   }
   EssentialGraph graph = map.Read([&](const MapData& data) {
-    return Build(data, fixed_keyframe, loops, corrected, priors, options);
+    return Build(data, fixed_keyframe, loops, corrected, priors, options, held_keyframes);
   });
   EssentialGraphResult result = graph.counts;
   result.summary = SolvePoseGraph(options.solver, &graph.problem);

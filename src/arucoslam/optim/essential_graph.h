@@ -3,6 +3,7 @@
 #pragma once
 
 #include <map>
+#include <set>
 #include <vector>
 
 #include "arucoslam/map/map.h"
@@ -67,10 +68,12 @@ std::map<KeyframeId, Sim3> PropagateLoopCorrection(const Map& map, KeyframeId cu
 // translation / scale) and every map point moved by its reference keyframe's correction
 // (S_new^-1 * S_old). Edges are measured from the map's current (uncorrected) poses; nodes
 // start at `corrected_cam_from_world` where given. `fixed_keyframe` is held (the loop
-// keyframe). Keyframes added while the solver runs follow their spanning-tree ancestor.
+// keyframe), and so is every keyframe of `held_keyframes`. Keyframes added while the solver
+// runs follow their spanning-tree ancestor.
 EssentialGraphResult OptimizeEssentialGraph(
     Map& map, KeyframeId fixed_keyframe, const std::vector<LoopConstraint>& loops,
     const std::map<KeyframeId, Sim3>& corrected_cam_from_world = {},
-    const std::vector<KeyframePosePrior>& priors = {}, const EssentialGraphOptions& options = {});
+    const std::vector<KeyframePosePrior>& priors = {}, const EssentialGraphOptions& options = {},
+    const std::set<KeyframeId>& held_keyframes = {});
 
 }  // namespace arucoslam

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <set>
 
 #include "arucoslam/optim/synthetic_loop.h"
 
@@ -231,6 +232,41 @@ TEST(EssentialGraphTest, MarkerPriorsAtTwoSightingsCorrectTheScaleDriftBetweenTh
               "%.3f m\n", before, after, points_before, PointRms(scene));
   EXPECT_LT(after, before / 4.0);
   EXPECT_LT(PointRms(scene), points_before / 2.0);
+}
+
+// Held keyframes (a merged map already in the world) keep their poses exactly while the
+// priors correct the rest.
+TEST(EssentialGraphTest, HeldKeyframesDoNotMove) {
+  SyntheticLoopOptions options;
+  options.scale_drift = 1.02;
+  options.scale_in_loop_edge = false;
+  LoopMap scene;
+  Build(scene, options);
+  std::set<KeyframeId> held;
+  for (int i = 0; i < 10; ++i) held.insert(scene.keyframes[i]);
+  std::vector<KeyframePosePrior> priors;
+  for (int i = 20; i < 40; i += 5) {
+    priors.push_back({scene.keyframes[i], scene.loop.truth_cam_from_world[i].Inverse(),
+                      1e4 * Matrix6d::Identity()});
+  }
+  const auto centres = [&] {
+    return scene.map.Read([&](const MapData& data) {
+      std::vector<Eigen::Vector3d> result;
+      for (const KeyframeId& id : scene.keyframes) {
+        result.push_back(data.FindKeyframe(id)->CameraCenter());
+      }
+      return result;
+    });
+  };
+  const std::vector<Eigen::Vector3d> before = centres();
+  const EssentialGraphResult result = OptimizeEssentialGraph(scene.map, KeyframeId(), {}, {},
+                                                             priors, EssentialGraphOptions{}, held);
+  ASSERT_TRUE(result.applied) << result.summary.message;
+  const std::vector<Eigen::Vector3d> after = centres();
+  for (int i = 0; i < 10; ++i) EXPECT_LT((after[i] - before[i]).norm(), 1e-9) << i;
+  double moved = 0.0;
+  for (int i = 20; i < 40; ++i) moved = std::max(moved, (after[i] - before[i]).norm());
+  EXPECT_GT(moved, 0.05);  // the priors (scale drift 2% per keyframe) did move the rest
 }
 
 TEST(EssentialGraphTest, EdgeSigmasMustBePositive) {

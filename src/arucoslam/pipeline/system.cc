@@ -465,7 +465,6 @@ void System::ResetMap() {
   {
     std::lock_guard lock(keyframe_fixes_mutex_);
     keyframe_fixes_.clear();
-    merged_bridge_priors_.clear();
   }
   next_alignment_anchors_ = 0;
   world_aligned_ = false;

@@ -185,16 +185,16 @@ struct SystemOptions {
   // a loss, the camera's motion over its last bridge_motion.max_span_s predicts (constant
   // velocity) the world pose of the next map's first keyframe, if that keyframe comes at
   // most bridge_motion.max_age_s after the last pose. The prediction is a prior of that
-  // keyframe in the pose-graph corrections once the two maps are merged in the world: the
-  // new map's stretch before its first marker then lies between two constraints. Standard
-  // deviations: bridge_position_sigma_m + bridge_position_sigma_per_s * gap (metres), and
-  // the same for rotation (radians; a turn in the gap is not predicted). 0.1 m per second:
-  // a robot at 0.7 m/s turning at 0.4 rad/s it did not before strays 0.14 m from the
-  // straight line in a second. Demo sequence, blocking, --ground-vehicle (a 1.07 s gap at
-  // the east end's turn, prediction 0.16 m off): world ATE 0.1085 m without the bridge,
-  // 0.1058 m with 0.05 + 0.2 m/s (0.26 m), 0.0949 m with these (0.13 m).
+  // keyframe in a pose-graph correction once the two maps are merged in the world (the
+  // absorbed map held): the new map's stretch before its first marker then lies between two
+  // constraints. Standard deviations: bridge_position_sigma_m + bridge_position_sigma_per_s
+  // * gap (metres), and the same for rotation (radians; a turn in the gap is not predicted).
+  // 0.1 m per second: a robot at 0.7 m/s turning at 0.4 rad/s it did not before strays
+  // 0.14 m from the straight line in a second. Demo sequence, blocking, --ground-vehicle (a
+  // 1.07 s gap at the east end's turn, prediction 0.16 m off): world ATE 0.1085 m without
+  // the bridge, 0.0921 m with it (BENCHMARKS.md).
   bool bridge_tracking_gaps = true;
-  WorldMotionPriorOptions bridge_motion{.max_age_s = 2.0, .min_span_s = 0.3, .max_span_s = 1.0};
+  WorldMotionPriorOptions bridge_motion{.max_age_s = 3.0, .min_span_s = 0.3, .max_span_s = 1.0};
   double bridge_position_sigma_m = 0.025;
   double bridge_position_sigma_per_s = 0.1;
   double bridge_rotation_sigma_rad = 0.05;
@@ -524,18 +524,14 @@ class System {
   };
   std::optional<ClosedMap> closed_map_;
   // Bridge over the gap between the closed map and the current one (system_bridge.cc): the
-  // closed map's last world poses, the current map's first keyframe's predicted pose, and
-  // once the closed map is merged (under keyframe_fixes_mutex_) that prior in force.
+  // closed map's last world poses and the current map's first keyframe's predicted pose.
   WorldMotionPrior motion_at_close_{options_.bridge_motion};
   std::vector<KeyframePosePrior> bridge_priors_;
-  std::vector<KeyframePosePrior> merged_bridge_priors_;
   void RememberMotionAtClose();
   void AddBridgePrior(KeyframeId keyframe, double timestamp_s);
-  // Once the closed map is merged: the whole map corrected by the pose graph with the
-  // marker priors and the bridge priors (false: nothing to bridge, or not applied).
+  // Once the closed map is merged: the new map corrected by the pose graph with the marker
+  // priors and the bridge priors, the absorbed keyframes held (false: nothing to bridge).
   bool CorrectAcrossBridge();
-  // Known-marker priors plus bridge priors, for every pose-graph correction of the map.
-  std::vector<KeyframePosePrior> CorrectionPriors() const;
   // Keyframes the current map absorbed from a closed one (already in the world: world
   // re-alignments leave them in place) and whether a point links them to the rest.
   std::set<KeyframeId> absorbed_keyframes_;

@@ -1,6 +1,7 @@
 // System's bridge over a tracking gap: the world-aligned map closed after a loss predicts,
 // from the camera's motion at its end, where the next map's first keyframe is; once both maps
-// are merged in the world, that prediction ties the new map's start in the pose graph.
+// are merged in the world, that prediction ties the new map's start in one pose-graph
+// correction (later corrections keep the shape it gave).
 #include <vector>
 
 #include "arucoslam/pipeline/system.h"
@@ -41,28 +42,21 @@ void System::AddBridgePrior(KeyframeId keyframe, double timestamp_s) {
       keyframe.value, gap_s, position_sigma, rotation_sigma);
 }
 
-std::vector<KeyframePosePrior> System::CorrectionPriors() const {
-  std::vector<KeyframePosePrior> priors = KnownMarkerPriors();
-  std::lock_guard lock(keyframe_fixes_mutex_);
-  priors.insert(priors.end(), merged_bridge_priors_.begin(), merged_bridge_priors_.end());
-  return priors;
-}
-
 bool System::CorrectAcrossBridge() {
   if (bridge_priors_.empty()) return false;
-  {
-    // From here on every correction keeps them (loops run on the places' thread).
-    std::lock_guard lock(keyframe_fixes_mutex_);
-    merged_bridge_priors_ = std::move(bridge_priors_);
-  }
+  std::vector<KeyframePosePrior> priors = KnownMarkerPriors();
+  priors.insert(priors.end(), bridge_priors_.begin(), bridge_priors_.end());
   bridge_priors_.clear();
   if (places_) places_->MapMovedExternally();
+  // The absorbed map is in the world already (adjusted with its markers when it was
+  // closed): only the new map bends, between the bridge at its start and its markers.
   const EssentialGraphResult result = OptimizeEssentialGraph(
-      *map_, KeyframeId(), {}, {}, CorrectionPriors(), options_.marker_correction_graph);
+      *map_, KeyframeId(), {}, {}, priors, options_.marker_correction_graph, absorbed_keyframes_);
   ARUCOSLAM_LOG_DEBUG(
       "merged map corrected across the tracking gap over {} keyframes with {} "
-      "priors: {}",
-      result.num_keyframes, result.num_priors, result.summary.BriefReport());
+      "priors, {} absorbed keyframes held: {}",
+      result.num_keyframes, result.num_priors, absorbed_keyframes_.size(),
+      result.summary.BriefReport());
   if (!result.applied) return false;
   if (places_) places_->RecordScaleChanges(result.scale_changes);
   std::lock_guard lock(stats_mutex_);

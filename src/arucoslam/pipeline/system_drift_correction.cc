@@ -40,7 +40,7 @@ bool System::CorrectDriftWithMarkers(KeyframeId keyframe) {
     if (found == keyframe_fixes_.end() || !found->second.known_markers_only) return false;
     own = MarkerPrior(keyframe, found->second);
   }
-  const std::vector<KeyframePosePrior> priors = CorrectionPriors();
+  const std::vector<KeyframePosePrior> priors = KnownMarkerPriors();
   const std::optional<double> offset_m = map_->Read([&](const MapData& data) -> std::optional<double> {
     const Keyframe* found = data.FindKeyframe(keyframe);
     if (found == nullptr) return std::nullopt;

@@ -26,7 +26,7 @@ void System::StartMarkerMapping() {
     if (places_) places_->SetMarkerLandmarks(marker_mapper_->mutable_landmarks());
   }
   if (places_ && options_.marker_priors_in_loops) {
-    places_->SetLoopPosePriors([this] { return CorrectionPriors(); },
+    places_->SetLoopPosePriors([this] { return KnownMarkerPriors(); },
                                options_.marker_correction_graph);
   }
   // Keyframes mapped before the alignment are recorded now, at their aligned poses.
