@@ -2,7 +2,9 @@
 // blocks on a left SE(3) manifold, analytic keypoint and marker-corner costs.
 #include <ceres/ceres.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -122,6 +124,29 @@ class GroundPlaneCost : public ceres::SizedCostFunction<3, kPoseSize, 1, 3> {
   GroundPlaneError error_;
 };
 
+class SmoothMotionCost : public ceres::SizedCostFunction<3, kPoseSize, kPoseSize, kPoseSize> {
+ public:
+  explicit SmoothMotionCost(const SmoothMotionError& error) : error_(error) {}
+  bool Evaluate(const double* const* parameters, double* residuals,
+                double** jacobians) const override {
+    Eigen::Vector3d residual;
+    SmoothMotionPoseJacobian d[3];
+    const bool want = jacobians != nullptr;
+    error_.Evaluate(FromBlock(parameters[0]), FromBlock(parameters[1]), FromBlock(parameters[2]),
+                    &residual, want ? &d[0] : nullptr, want ? &d[1] : nullptr,
+                    want ? &d[2] : nullptr);
+    Eigen::Map<Eigen::Vector3d> whitened(residuals);
+    whitened = residual;
+    for (int k = 0; want && k < 3; ++k) {
+      if (jacobians[k] != nullptr) WritePoseJacobian<3>(d[k], 1.0, jacobians[k]);
+    }
+    return true;
+  }
+
+ private:
+  SmoothMotionError error_;
+};
+
 // Ceres parameter blocks of a problem; `*_used` says which ones a residual touches.
 struct Blocks {
   std::vector<PoseBlock> poses, markers;
@@ -215,6 +240,33 @@ bool AddGroundPlanePrior(const GroundPlanePriorOptions& options, ceres::Manifold
   return true;
 }
 
+// The smooth-motion prior on every three used, timed poses consecutive in time whose gaps are
+// positive and at most max_gap_s. Returns the number of residuals added.
+int AddSmoothMotionPrior(const SmoothMotionPriorOptions& options,
+                         const std::vector<double>& timestamps_s, Blocks* blocks,
+                         ceres::Problem* ceres_problem) {
+  std::vector<std::size_t> timed;
+  for (std::size_t i = 0; i < timestamps_s.size() && i < blocks->poses.size(); ++i) {
+    if (blocks->pose_used[i] && std::isfinite(timestamps_s[i])) timed.push_back(i);
+  }
+  std::stable_sort(timed.begin(), timed.end(),
+                   [&](std::size_t a, std::size_t b) { return timestamps_s[a] < timestamps_s[b]; });
+  int added = 0;
+  for (std::size_t k = 2; k < timed.size(); ++k) {
+    const double dt1 = timestamps_s[timed[k - 1]] - timestamps_s[timed[k - 2]];
+    const double dt2 = timestamps_s[timed[k]] - timestamps_s[timed[k - 1]];
+    if (!(dt1 > 1e-6 && dt2 > 1e-6 && dt1 <= options.max_gap_s && dt2 <= options.max_gap_s)) {
+      continue;
+    }
+    ceres_problem->AddResidualBlock(new SmoothMotionCost(SmoothMotionError(options, dt1, dt2)),
+                                    nullptr, blocks->poses[timed[k - 2]].data(),
+                                    blocks->poses[timed[k - 1]].data(),
+                                    blocks->poses[timed[k]].data());
+    ++added;
+  }
+  return added;
+}
+
 void FlagOutliers(const MarkerBundleAdjustmentOptions& options,
                   const MarkerBundleAdjustmentProblem& problem,
                   MarkerBundleAdjustmentSummary* summary) {
@@ -277,6 +329,10 @@ MarkerBundleAdjustmentSummary SolveMarkerBundleAdjustment(
   const bool ground_plane =
       problem->ground_plane_prior &&
       AddGroundPlanePrior(*problem->ground_plane_prior, &sphere, &blocks, &ceres_problem);
+  if (problem->smooth_motion_prior) {
+    AddSmoothMotionPrior(*problem->smooth_motion_prior, problem->pose_timestamps_s, &blocks,
+                         &ceres_problem);
+  }
   summary.num_residual_blocks = ceres_problem.NumResidualBlocks();
   if (summary.num_residual_blocks == 0) {
     summary.success = true;
