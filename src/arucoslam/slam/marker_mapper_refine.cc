@@ -134,7 +134,7 @@ MarkerBundleAdjustmentSummary MarkerMapper::Refine(MapData* map) {
   ProblemIndex index;
   MarkerBundleAdjustmentProblem problem = BuildProblem(map, &index);
   problem.ground_plane_prior = options_.ground_plane_prior;
-  problem.smooth_motion_prior = options_.smooth_motion_prior;
+  problem.vehicle_motion_prior = options_.vehicle_motion_prior;
   // Retired views are not timed; the live keyframes' times were set in BuildProblem.
   if (!problem.pose_timestamps_s.empty()) {
     problem.pose_timestamps_s.resize(problem.keypoints.poses.size(),
