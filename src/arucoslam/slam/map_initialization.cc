@@ -8,11 +8,11 @@ namespace {
 
 // Both views of the initial points, refined together; camera 1 stays fixed.
 BundleAdjustmentProblem MakeProblem(const Frame& frame1, const Frame& frame2,
-                                    const InitializationResult& initialization) {
+                                    const InitializationResult& initialization, bool hold_motion) {
   BundleAdjustmentProblem problem;
   problem.intrinsics = PinholeIntrinsics::FromCamera(frame1.camera);
   problem.poses.push_back({Rigid3::Identity(), true});
-  problem.poses.push_back({initialization.cam2_from_cam1, false});
+  problem.poses.push_back({initialization.cam2_from_cam1, hold_motion});
   for (std::size_t k = 0; k < initialization.matches.size(); ++k) {
     const FeatureMatch& match = initialization.matches[k];
     problem.points.push_back({initialization.points_in_cam1[k], false});
@@ -35,7 +35,8 @@ InitialMapResult CreateInitialMap(Map& map, Frame& frame1, Frame& frame2,
     result.message = "initialisation did not succeed";
     return result;
   }
-  BundleAdjustmentProblem problem = MakeProblem(frame1, frame2, initialization);
+  BundleAdjustmentProblem problem =
+      MakeProblem(frame1, frame2, initialization, options.hold_motion);
   const BundleAdjustmentSummary summary =
       SolveBundleAdjustment(options.bundle_adjustment, &problem);
   if (!summary.success) {
