@@ -290,6 +290,19 @@ std::vector<HomographyMotion> DecomposeHomography(const Eigen::Matrix3d& homogra
 }
 
 // ---- Relative pose refinement (Sampson errors) ----
+double SampsonErrorOfEssential(const Eigen::Matrix3d& e, const Eigen::Vector2d& normalised1,
+                               const Eigen::Vector2d& normalised2) {
+  const Eigen::Vector3d x1 = normalised1.homogeneous(), x2 = normalised2.homogeneous();
+  const Eigen::Vector3d ex1 = e * x1, etx2 = e.transpose() * x2;
+  const double denominator = ex1.head<2>().squaredNorm() + etx2.head<2>().squaredNorm();
+  if (denominator <= 0.0) return 0.0;
+  return x2.dot(ex1) / std::sqrt(denominator);
+}
+
+Eigen::Matrix3d EssentialOf(const Rigid3& motion) {
+  return Hat(motion.translation) * motion.RotationMatrix();
+}
+
 namespace {
 
 using Vector5d = Eigen::Matrix<double, 5, 1>;
@@ -310,19 +323,6 @@ Eigen::Matrix<double, 3, 2> TangentBasis(const Eigen::Vector3d& t) {
   basis.col(0) = t.cross(helper).normalized();
   basis.col(1) = t.cross(basis.col(0)).normalized();
   return basis;
-}
-
-double SampsonErrorOfEssential(const Eigen::Matrix3d& e, const Eigen::Vector2d& normalised1,
-                               const Eigen::Vector2d& normalised2) {
-  const Eigen::Vector3d x1 = normalised1.homogeneous(), x2 = normalised2.homogeneous();
-  const Eigen::Vector3d ex1 = e * x1, etx2 = e.transpose() * x2;
-  const double denominator = ex1.head<2>().squaredNorm() + etx2.head<2>().squaredNorm();
-  if (denominator <= 0.0) return 0.0;
-  return x2.dot(ex1) / std::sqrt(denominator);
-}
-
-Eigen::Matrix3d EssentialOf(const Rigid3& motion) {
-  return Hat(motion.translation) * motion.RotationMatrix();
 }
 
 Eigen::VectorXd Residuals(const Rigid3& motion, const Point2dList& n1, const Point2dList& n2) {

@@ -75,6 +75,12 @@ std::vector<HomographyMotion> DecomposeHomography(const Eigen::Matrix3d& homogra
                                                   const Eigen::Matrix3d& k1,
                                                   const Eigen::Matrix3d& k2);
 
+// The essential matrix [t]x R of a motion cam2_from_cam1 = (R, t).
+Eigen::Matrix3d EssentialOf(const Rigid3& motion);
+// Signed Sampson error (normalised units) of x2^T E x1 = 0 for one correspondence; 0 where
+// it is undefined (both epipolar lines degenerate).
+double SampsonErrorOfEssential(const Eigen::Matrix3d& e, const Eigen::Vector2d& normalised1,
+                               const Eigen::Vector2d& normalised2);
 // Sampson error (normalised units) of x2^T [t]x R x1 = 0 for one correspondence.
 double SampsonError(const Rigid3& cam2_from_cam1, const Eigen::Vector2d& normalised1,
                     const Eigen::Vector2d& normalised2);

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "arucoslam/geometry/two_view.h"
+
 namespace arucoslam {
 
 Rigid3 VehicleMotion(const Eigen::Vector3d& up, double angle_rad) {
@@ -29,19 +31,12 @@ VehicleTwoViewResult SolveVehicleTwoView(const std::vector<Eigen::Vector2d>& x1,
   for (int step = -steps; step <= steps; ++step) {
     const double angle = angle_centre_rad + step * options.angle_step_rad;
     const Rigid3 motion = VehicleMotion(up, angle);
-    const Eigen::Vector3d& t = motion.translation;
-    Eigen::Matrix3d t_cross;
-    t_cross << 0.0, -t.z(), t.y(), t.z(), 0.0, -t.x(), -t.y(), t.x(), 0.0;
-    const Eigen::Matrix3d essential = t_cross * motion.rotation.toRotationMatrix();
+    const Eigen::Matrix3d essential = EssentialOf(motion);
     double cost = 0.0;
     int inliers = 0;
     for (std::size_t i = 0; i < n && cost < best.cost; ++i) {
-      const Eigen::Vector3d p1 = x1[i].homogeneous(), p2 = x2[i].homogeneous();
-      const Eigen::Vector3d line2 = essential * p1, line1 = essential.transpose() * p2;
-      const double numerator = p2.dot(line2);
-      const double denominator = line2.head<2>().squaredNorm() + line1.head<2>().squaredNorm();
-      const double error_sq =
-          denominator > 0.0 ? numerator * numerator / denominator * focal_sq : max_error_sq;
+      const double error = SampsonErrorOfEssential(essential, x1[i], x2[i]);
+      const double error_sq = error * error * focal_sq;
       cost += std::min(error_sq, max_error_sq);
       inliers += error_sq < max_error_sq ? 1 : 0;
     }

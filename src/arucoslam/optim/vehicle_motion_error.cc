@@ -8,16 +8,6 @@ namespace {
 
 using Matrix36d = Eigen::Matrix<double, 3, 6>;
 
-Eigen::Vector3d Centre(const Rigid3& cam_from_world) {
-  return -(cam_from_world.rotation.conjugate() * cam_from_world.translation);
-}
-
-Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return m;
-}
-
 // u = R0 d + R1 d, the displacement d = c1 - c0 in both cameras' frames, and its Jacobians
 // w.r.t. the left perturbations of both poses. With (R, t) -> Exp(delta) (R, t) the centre
 // moves by -R^T upsilon and R v by -[R v]x omega (to first order).
@@ -29,15 +19,16 @@ struct Interval {
 Interval MakeInterval(const Rigid3& cam0_from_world, const Rigid3& cam1_from_world) {
   const Eigen::Matrix3d r0 = cam0_from_world.rotation.toRotationMatrix();
   const Eigen::Matrix3d r1 = cam1_from_world.rotation.toRotationMatrix();
-  const Eigen::Vector3d d = Centre(cam1_from_world) - Centre(cam0_from_world);
+  const Eigen::Vector3d d =
+      cam1_from_world.Inverse().translation - cam0_from_world.Inverse().translation;
   const Eigen::Vector3d a = r0 * d, b = r1 * d;
   Interval interval;
   interval.u = a + b;
   const Eigen::Matrix3d sum = r0 + r1;
   interval.d_pose0.leftCols<3>() = sum * r0.transpose();
-  interval.d_pose0.rightCols<3>() = -Skew(a);
+  interval.d_pose0.rightCols<3>() = -Hat(a);
   interval.d_pose1.leftCols<3>() = -sum * r1.transpose();
-  interval.d_pose1.rightCols<3>() = -Skew(b);
+  interval.d_pose1.rightCols<3>() = -Hat(b);
   return interval;
 }
 

@@ -11,6 +11,7 @@
 #include "arucoslam/pipeline/system.h"
 #include "arucoslam/slam/map_initialization.h"
 #include "arucoslam/util/logging.h"
+#include "arucoslam/util/median.h"
 
 namespace arucoslam {
 namespace {
@@ -51,10 +52,7 @@ InitializationResult TriangulateWithKnownMotion(const Frame& frame1, const Frame
     parallaxes.push_back(quality.parallax_rad * 180.0 / std::numbers::pi);
   }
   const int num_points = static_cast<int>(result.matches.size());
-  if (num_points > 0) {
-    std::nth_element(parallaxes.begin(), parallaxes.begin() + num_points / 2, parallaxes.end());
-    result.median_parallax_deg = parallaxes[num_points / 2];
-  }
+  result.median_parallax_deg = Median(parallaxes);
   result.cam2_from_cam1 = cam2_from_cam1;
   result.success = num_points >= options.min_triangulated &&
                    result.median_parallax_deg >= min_parallax_deg;
@@ -138,13 +136,7 @@ bool System::InitializeFromVehicleModel(Frame& frame, const InitializationResult
     return true;
   };
   if (!triangulated.success) return refuse(triangulated.message);
-  // Median depth 1 in camera 1, as the free initialiser scales its maps.
-  std::vector<double> depths;
-  for (const Eigen::Vector3d& point : triangulated.points_in_cam1) depths.push_back(point.z());
-  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
-  const double scale = 1.0 / depths[depths.size() / 2];
-  for (Eigen::Vector3d& point : triangulated.points_in_cam1) point *= scale;
-  triangulated.cam2_from_cam1.translation *= scale;
+  ScaleToUnitMedianDepth(&triangulated);  // the free initialiser's gauge
   InitialMapOptions held = options_.initial_map;
   held.hold_motion = true;
   const InitialMapResult created = CreateInitialMap(*map_, first, frame, triangulated, held);

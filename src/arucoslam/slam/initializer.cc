@@ -242,21 +242,27 @@ InitializationResult ChooseMotion(const InitializerOptions& options, Initializat
   if (static_cast<int>(chosen.usable.size()) < options.min_triangulated) {
     return Fail(std::move(result), InitFailure::kTooFewTriangulated, summary);
   }
-  std::vector<double> depths;
-  for (const Eigen::Vector3d& p : chosen.points) depths.push_back(p.z());
-  const double scale = 1.0 / Median(depths);
   result.success = true;
   result.message = summary;
   result.cam2_from_cam1 = motion;
-  result.cam2_from_cam1.translation *= scale;
   for (std::size_t u = 0; u < chosen.usable.size(); ++u) {
     result.matches.push_back(matches[chosen.usable[u]]);
-    result.points_in_cam1.push_back(scale * chosen.points[u]);
+    result.points_in_cam1.push_back(chosen.points[u]);
   }
+  ScaleToUnitMedianDepth(&result);
   return result;
 }
 
 }  // namespace
+
+void ScaleToUnitMedianDepth(InitializationResult* result) {
+  if (result->points_in_cam1.empty()) return;
+  std::vector<double> depths;
+  for (const Eigen::Vector3d& point : result->points_in_cam1) depths.push_back(point.z());
+  const double scale = 1.0 / Median(depths);
+  result->cam2_from_cam1.translation *= scale;
+  for (Eigen::Vector3d& point : result->points_in_cam1) point *= scale;
+}
 
 InitializationResult Initializer::InitializeFromMatches(
     const std::vector<Eigen::Vector2d>& normalised1,

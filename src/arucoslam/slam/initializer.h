@@ -70,6 +70,10 @@ struct InitializationResult {
   std::vector<Eigen::Vector3d> points_in_cam1;
 };
 
+// Rescales a two-view result (motion and points together) so that the median depth of its
+// points in camera 1 is 1, the gauge of every monocular initial map. No points: unchanged.
+void ScaleToUnitMedianDepth(InitializationResult* result);
+
 class Initializer {
  public:
   explicit Initializer(const InitializerOptions& options = {});
