@@ -88,6 +88,9 @@ void AddWorldCommand(CLI::App& app, int& exit_status) {
       ->add_option("--markers-per-dock", args->options.markers_per_dock,
                    "markers side by side on each dock board, 1-4")
       ->capture_default_str();
+  factory->add_flag("--corridor-end-markers", args->options.corridor_end_markers,
+                    "one more marker board on the corridor's long wall at each end (the wall "
+                    "the route faces while it turns there)");
   factory
       ->add_option("--camera-height", args->options.camera_height_m,
                    "height of the route's camera and of the marker centres, metres")

@@ -123,6 +123,19 @@ class FactoryBuilder {
                   SeededRandom& random);
   void AddDocks();
   void AddDock(const std::string& name, double x_wall, double y, bool faces_plus_x, int first_id);
+  // A board at camera height against a wall (`world_from_board`: +x out of the wall) carrying
+  // markers_per_dock markers from `first_id`; their ids, or none without markers.
+  std::vector<int> AddMarkerBoard(FactoryModel& model, const Rigid3& world_from_board,
+                                  int first_id);
+  // A marker's box side (black square and quiet zone, metres) and a board's width.
+  double MarkerSide() const {
+    MarkerImageOptions image;
+    image.marker_size_px = options_.marker_image_px;
+    return MarkerBoxSide(options_.marker_size_m, options_.dictionary, image);
+  }
+  double MarkerBoardWidth() const {
+    return std::max(0.7, options_.markers_per_dock * (MarkerSide() + 0.08) + 0.15);
+  }
   void AddEndMachines();
   void AddPosters();
   void AddDefaultRoute();
@@ -401,7 +414,8 @@ void FactoryBuilder::AddDocks() {
   const int per_dock = options_.markers_per_dock;
   std::vector<double> lanes = {kCorridor / 2};
   for (int a = 0; a < options_.aisles; ++a) lanes.push_back(AisleCentre(a));
-  const int needed = static_cast<int>(lanes.size()) * 2 * per_dock;
+  const int needed =
+      (static_cast<int>(lanes.size()) * 2 + (options_.corridor_end_markers ? 2 : 0)) * per_dock;
   const int available = DictionaryFromName(options_.dictionary, "--dictionary")->bytesList.rows;
   if (options_.markers && needed > available) {
     throw InputError("--markers-per-dock", std::to_string(needed) + " markers are needed but " +
@@ -416,6 +430,43 @@ void FactoryBuilder::AddDocks() {
     AddDock("dock_" + lane_name + "_east", Length(), lanes[lane], false, next_id);
     next_id += per_dock;
   }
+  if (!options_.corridor_end_markers || !options_.markers) return;
+  for (const double x : {1.8, Length() - 1.8}) {
+    const Rigid3 world_from_board = Pose(x, 0.0, 0.0, kPi / 2);  // facing +y
+    FactoryModel& model =
+        NewModel(x < Length() / 2 ? "sign_corridor_west" : "sign_corridor_east", world_from_board);
+    AddMarkerBoard(model, world_from_board, next_id);
+    next_id += per_dock;
+  }
+}
+
+std::vector<int> FactoryBuilder::AddMarkerBoard(FactoryModel& model, const Rigid3& world_from_board,
+                                                int first_id) {
+  const int k = options_.markers_per_dock;
+  const double side = MarkerSide();
+  const double spacing = side + 0.08;
+  const double h = options_.camera_height_m;
+  const double board_height = std::max(0.9, side + 0.3);
+  model.visuals.push_back(Box("board", Pose(kBoardThickness / 2, 0, h),
+                              {kBoardThickness, MarkerBoardWidth(), board_height},
+                              {0.92, 0.92, 0.9}));
+  std::vector<int> ids;
+  if (!options_.markers) return ids;
+  Eigen::Matrix3d board_from_marker_rotation;  // columns: marker x, y, z in the board frame
+  board_from_marker_rotation << 0, 0, 1, 1, 0, 0, 0, 1, 0;
+  for (int j = 0; j < k; ++j) {
+    MarkerInfo marker;
+    marker.id = first_id + j;
+    marker.size = options_.marker_size_m;
+    // Marker j counted from the left as the robot sees it (board +y is the robot's left).
+    const double offset = ((k - 1) / 2.0 - j) * spacing;
+    marker.world_from_marker =
+        world_from_board *
+        Rigid3(board_from_marker_rotation, Eigen::Vector3d(kBoardThickness + 0.002, offset, h));
+    world_.markers.markers[marker.id] = marker;
+    ids.push_back(marker.id);
+  }
+  return ids;
 }
 
 // A charging station against an end wall: a base, a board at camera height carrying the
@@ -424,16 +475,8 @@ void FactoryBuilder::AddDock(const std::string& name, double x_wall, double y, b
                              int first_id) {
   const Rigid3 world_from_dock = Pose(x_wall, y, 0, faces_plus_x ? 0.0 : kPi);
   FactoryModel& model = NewModel(name, world_from_dock);
-  const int k = options_.markers_per_dock;
-  MarkerImageOptions image;
-  image.marker_size_px = options_.marker_image_px;
-  const double side = MarkerBoxSide(options_.marker_size_m, options_.dictionary, image);
-  const double spacing = side + 0.08;
-  const double board_width = std::max(0.7, k * spacing + 0.15);
-  const double h = options_.camera_height_m;
-  const double board_height = std::max(0.9, side + 0.3);
-  model.visuals.push_back(Box("board", Pose(kBoardThickness / 2, 0, h),
-                              {kBoardThickness, board_width, board_height}, {0.92, 0.92, 0.9}));
+  const std::vector<int> ids = AddMarkerBoard(model, world_from_dock, first_id);
+  const double board_width = MarkerBoardWidth();
   model.visuals.push_back(Box("base", Pose(0.25, 0, 0.125), {0.46, 0.7, 0.25}, kDarkGrey));
   model.visuals.push_back(Box("stripe", Pose(0.485, 0, 0.06), {0.01, 0.7, 0.08}, kWhite, "hazard"));
   for (const double dy : {-0.15, 0.15}) {
@@ -446,22 +489,7 @@ void FactoryBuilder::AddDock(const std::string& name, double x_wall, double y, b
   dock.name = name;
   dock.front = (world_from_dock * Eigen::Vector3d(1.0 + kBoardThickness, 0, 0)).head<2>();
   dock.facing = (world_from_dock.rotation * Eigen::Vector3d::UnitX()).head<2>();
-  if (options_.markers) {
-    Eigen::Matrix3d dock_from_marker_rotation;  // columns: marker x, y, z in the dock frame
-    dock_from_marker_rotation << 0, 0, 1, 1, 0, 0, 0, 1, 0;
-    for (int j = 0; j < k; ++j) {
-      MarkerInfo marker;
-      marker.id = first_id + j;
-      marker.size = options_.marker_size_m;
-      // Marker j counted from the left as the robot sees it (dock +y is the robot's left).
-      const double offset = ((k - 1) / 2.0 - j) * spacing;
-      marker.world_from_marker =
-          world_from_dock *
-          Rigid3(dock_from_marker_rotation, Eigen::Vector3d(kBoardThickness + 0.002, offset, h));
-      world_.markers.markers[marker.id] = marker;
-      dock.marker_ids.push_back(marker.id);
-    }
-  }
+  dock.marker_ids = ids;
   world_.docks.push_back(dock);
 }
 

@@ -25,6 +25,10 @@ struct FactoryOptions {
   double marker_size_m = 0.2;                    // side of the black square, (0.05, 1] m
   std::string dictionary = "DICT_4X4_50";
   int markers_per_dock = 1;      // side by side on the dock board, [1, 4]
+  // One more marker board at each end of the corridor, on its long (y = 0) wall 1.8 m from
+  // the end wall, facing into the corridor: the wall a robot faces while it turns there.
+  // Ids after the docks'. Only with markers.
+  bool corridor_end_markers = false;
   int marker_image_px = 240;     // marker PNG: side of the black square, pixels
   double camera_height_m = 0.6;  // marker centres and the route's camera, [0.3, 1.0] m
 

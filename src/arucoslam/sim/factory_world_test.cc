@@ -175,6 +175,45 @@ Eigen::Quaterniond ToEigen(const ignition::math::Quaterniond& q) {
   return Eigen::Quaterniond(q.W(), q.X(), q.Y(), q.Z());
 }
 
+// The corridor-end boards hang on the corridor's y = 0 wall facing +y, ids after the docks'
+// (the dock markers unchanged), and the default route faces the east one in its turn: within
+// 35 degrees of the camera axis and 4 m for at least 0.3 m of driving.
+TEST_F(FactoryWorldTest, CorridorEndMarkersFaceTheRouteInItsTurn) {
+  const FactoryWorld plain = BuildFactoryWorld(FactoryOptions{});
+  FactoryOptions options;
+  options.corridor_end_markers = true;
+  const FactoryWorld world = BuildFactoryWorld(options);
+  ASSERT_EQ(world.markers.markers.size(), plain.markers.markers.size() + 2);
+  for (const auto& [id, marker] : plain.markers.markers) {
+    EXPECT_LT((world.markers.markers.at(id).world_from_marker.translation -
+               marker.world_from_marker.translation)
+                  .norm(),
+              1e-12);
+  }
+  const int first = static_cast<int>(plain.markers.markers.size());
+  const std::vector<TimedPose> poses = GenerateCameraPath(world.default_route, PathRun::kTeach);
+  for (const int id : {first, first + 1}) {
+    const MarkerInfo& marker = world.markers.markers.at(id);
+    const Eigen::Vector3d z = marker.world_from_marker.rotation * Eigen::Vector3d::UnitZ();
+    EXPECT_NEAR(z.y(), 1.0, 1e-12);
+    EXPECT_NEAR(marker.world_from_marker.translation.y(), 0.022, 1e-12);  // on a 2 cm board
+    EXPECT_NEAR(marker.world_from_marker.translation.z(), options.camera_height_m, 1e-12);
+  }
+  const MarkerInfo& east = world.markers.markers.at(first + 1);
+  EXPECT_GT(east.world_from_marker.translation.x(), world.hall_length_m / 2);
+  double facing_distance = 0.0;
+  for (std::size_t i = 1; i < poses.size(); ++i) {
+    const Rigid3& cam = poses[i].world_from_cam;
+    const Eigen::Vector3d to_marker = east.world_from_marker.translation - cam.translation;
+    const Eigen::Vector3d forward = cam.rotation * Eigen::Vector3d::UnitZ();
+    if (forward.dot(to_marker.normalized()) > std::cos(35.0 * kPi / 180) &&
+        to_marker.norm() < 4.0) {
+      facing_distance += (cam.translation - poses[i - 1].world_from_cam.translation).norm();
+    }
+  }
+  EXPECT_GE(facing_distance, 0.3);
+}
+
 TEST_F(FactoryWorldTest, SdformatParsesTheWorldAndMarkerPosesMatchTheJson) {
   FactoryOptions options;
   options.aisles = 2;
