@@ -112,6 +112,27 @@ TEST_F(FactoryWorldTest, DefaultRouteIsAShortLoopWithATightTurn) {
   EXPECT_GE(best_turn * 180.0 / kPi, 150.0);
 }
 
+// Metres driven along `poses` while `target` is within `max_angle_deg` of the camera's axis
+// and nearer than `max_distance_m` (and, with `normal`, the camera within `max_angle_deg` of
+// that direction out of the target).
+double DistanceDrivenFacing(const std::vector<TimedPose>& poses, const Eigen::Vector3d& target,
+                            double max_angle_deg, double max_distance_m,
+                            const Eigen::Vector3d* normal = nullptr) {
+  const double min_cos = std::cos(max_angle_deg * kPi / 180);
+  double distance = 0.0;
+  for (std::size_t i = 1; i < poses.size(); ++i) {
+    const Rigid3& cam = poses[i].world_from_cam;
+    const Eigen::Vector3d to_target = target - cam.translation;
+    const Eigen::Vector3d forward = cam.rotation * Eigen::Vector3d::UnitZ();
+    if (forward.dot(to_target.normalized()) > min_cos &&
+        (normal == nullptr || normal->dot(-to_target.normalized()) > min_cos) &&
+        to_target.norm() < max_distance_m) {
+      distance += (cam.translation - poses[i - 1].world_from_cam.translation).norm();
+    }
+  }
+  return distance;
+}
+
 // Every dock the route visits is approached head-on: for at least 2 m of driving the marker
 // is ahead of the camera, within 25 degrees of its axis, with its +z facing the camera.
 TEST_F(FactoryWorldTest, DockMarkersFaceTheApproach) {
@@ -129,16 +150,8 @@ TEST_F(FactoryWorldTest, DockMarkersFaceTheApproach) {
       EXPECT_NEAR(z.head<2>().dot(dock.facing), 1.0, 1e-12);  // out of the board
       EXPECT_NEAR(y.z(), 1.0, 1e-12);                         // upright
       EXPECT_NEAR(marker.world_from_marker.translation.z(), options.camera_height_m, 1e-12);
-      double facing_distance = 0.0;
-      for (std::size_t i = 1; i < poses.size(); ++i) {
-        const Rigid3& cam = poses[i].world_from_cam;
-        const Eigen::Vector3d to_marker = marker.world_from_marker.translation - cam.translation;
-        const Eigen::Vector3d forward = cam.rotation * Eigen::Vector3d::UnitZ();
-        if (forward.dot(to_marker.normalized()) > std::cos(25.0 * kPi / 180) &&
-            z.dot(-to_marker.normalized()) > std::cos(25.0 * kPi / 180) && to_marker.norm() < 8.0) {
-          facing_distance += (cam.translation - poses[i - 1].world_from_cam.translation).norm();
-        }
-      }
+      const double facing_distance =
+          DistanceDrivenFacing(poses, marker.world_from_marker.translation, 25.0, 8.0, &z);
       EXPECT_EQ(facing_distance >= 2.0, dock.on_default_route)
           << dock.name << " " << facing_distance;
     }
@@ -201,17 +214,7 @@ TEST_F(FactoryWorldTest, CorridorEndMarkersFaceTheRouteInItsTurn) {
   }
   const MarkerInfo& east = world.markers.markers.at(first + 1);
   EXPECT_GT(east.world_from_marker.translation.x(), world.hall_length_m / 2);
-  double facing_distance = 0.0;
-  for (std::size_t i = 1; i < poses.size(); ++i) {
-    const Rigid3& cam = poses[i].world_from_cam;
-    const Eigen::Vector3d to_marker = east.world_from_marker.translation - cam.translation;
-    const Eigen::Vector3d forward = cam.rotation * Eigen::Vector3d::UnitZ();
-    if (forward.dot(to_marker.normalized()) > std::cos(35.0 * kPi / 180) &&
-        to_marker.norm() < 4.0) {
-      facing_distance += (cam.translation - poses[i - 1].world_from_cam.translation).norm();
-    }
-  }
-  EXPECT_GE(facing_distance, 0.3);
+  EXPECT_GE(DistanceDrivenFacing(poses, east.world_from_marker.translation, 35.0, 4.0), 0.3);
 }
 
 TEST_F(FactoryWorldTest, SdformatParsesTheWorldAndMarkerPosesMatchTheJson) {
