@@ -28,8 +28,10 @@ bool SystemOptions::Check() const {
          min_alignment_baseline_m >= 0.0 && max_alignment_rms_m > 0.0 &&
          max_alignment_scale > 0.0 && marker_reset_lost_frames >= 1 &&
          max_realignment_anchors >= min_alignment_anchors && places.Check() &&
-         max_marker_disagreement_m > 0.0 && min_frames_between_anchor_keyframes >= 0 &&
-         marker_mapping.Check() && new_map_after_lost_s > 0.0 && min_marker_init_baseline_m > 0.0 &&
+         max_marker_disagreement_m > 0.0 && min_drift_interval_s >= 0.0 &&
+         max_drift_correction_frames >= 1 && max_drift_step_m >= 0.0 &&
+         min_frames_between_anchor_keyframes >= 0 && marker_mapping.Check() &&
+         new_map_after_lost_s > 0.0 && min_marker_init_baseline_m > 0.0 &&
          min_marker_init_parallax_deg >= 0.0 && marker_search.Check() && rotation_vote.Check() &&
          map_rotation_gates.Check() && refine_min_inlier_fraction > 0.0 &&
          refine_min_inlier_fraction <= 1.0 && bridge_motion.Check() &&
@@ -295,7 +297,7 @@ void System::Track(Frame& frame, FrameReport& report) {
   FollowMapCorrections();
   TrackingResult result = tracker_->Track(frame, world_aligned_ && fix_ ? fix_->markers : kNoMarkers);
   if (result.state == TrackingState::kTracking && frame.cam_from_world &&
-      DisagreesWithMarkers(*frame.cam_from_world)) {
+      DisagreesWithMarkers(*frame.cam_from_world) && !TakeDisagreementAsDrift(frame, report)) {
     ARUCOSLAM_LOG_DEBUG("frame {}: keypoint pose {:.2f} m from the markers' location, rejected",
                         report.index,
                         (frame.cam_from_world->Inverse().translation -
@@ -306,11 +308,13 @@ void System::Track(Frame& frame, FrameReport& report) {
     std::lock_guard lock(stats_mutex_);
     ++stats_.num_marker_disagreements;
   }
+  bool relocalized = false;
   if (result.state != TrackingState::kTracking &&
       (RelocalizeWithMarkers(frame, report) || RelocalizeWithPlaces(frame, report) ||
        RelocalizeInLoadedMap(frame, report))) {
     result.state = TrackingState::kTracking;
     result.num_inliers = report.num_inliers;
+    relocalized = true;
   }
   report.state = result.state;
   report.num_inliers = result.num_inliers;
@@ -344,6 +348,7 @@ void System::Track(Frame& frame, FrameReport& report) {
   }
   last_state_ = TrackingState::kTracking;
   lost_frames_.clear();
+  NoteMarkerAgreement(frame, relocalized);
   VoteForWorldRotation(frame);
   lost_with_markers_ = 0;
   lost_since_s_.reset();
@@ -371,7 +376,11 @@ void System::MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& rep
       fix_ && !world_aligned_ &&
       frames_since_keyframe_ >= options_.min_frames_between_anchor_keyframes &&
       num_inliers > options_.keyframes.min_tracked_points && input.mapper_has_room;
-  if (!wants_anchor && !DecideKeyframe(options_.keyframes, input).insert) return;
+  const bool wants_drift_keyframe = drift_keyframe_wanted_ && input.mapper_has_room;
+  if (!wants_anchor && !wants_drift_keyframe && !DecideKeyframe(options_.keyframes, input).insert) {
+    return;
+  }
+  drift_keyframe_wanted_ = false;
   const KeyframeId keyframe = InsertKeyframe(*map_, frame, tracker_->reference_keyframe());
   tracker_->SetReferenceKeyframe(keyframe);
   frames_since_keyframe_ = 0;
@@ -474,6 +483,10 @@ void System::ResetMap() {
   bridge_priors_.clear();
   lost_with_markers_ = 0;
   lost_since_s_.reset();
+  markers_agreed_s_.reset();
+  last_marker_offset_.reset();
+  drift_frames_ = 0;
+  drift_keyframe_wanted_ = false;
   last_state_ = TrackingState::kNotInitialized;
   mapping_busy_ = false;
   StartMappingThread();

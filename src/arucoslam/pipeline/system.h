@@ -130,6 +130,19 @@ struct SystemOptions {
   // lost and restarts from the markers. A place-database relocalisation is accepted only when
   // a marker location of the frame agrees with it this closely.
   double max_marker_disagreement_m = 0.5;
+  // Drift, not a look-alike place: a disagreement is taken as drift when the map has been
+  // tracked without a break (no relocalisation the markers did not confirm, no new map) for
+  // at least min_drift_interval_s since its markers last agreed with it. The frame keeps
+  // its keypoint pose and becomes a keyframe whose marker location corrects the whole map
+  // (CorrectDriftWithMarkers); the next max_drift_correction_frames frames wait for that
+  // correction, after which a disagreement is a look-alike place again. Sooner after the
+  // markers agreed, a disagreement is drift only if it grew by at most max_drift_step_m
+  // since the previous frame with a marker location: the map does not drift half a metre
+  // at once.
+  bool correct_drift_beyond_gate = true;
+  double min_drift_interval_s = 2.0;
+  double max_drift_step_m = 0.25;  // growth of the disagreement since the last marker frame
+  int max_drift_correction_frames = 15;
   // Once the map is world-aligned, keyframes' marker observations join local BA and the
   // global BA after a loop (known markers fixed) and markers the map lacks are mapped
   // (system_marker_mapping.cc).
@@ -178,6 +191,10 @@ struct SystemOptions {
     graph.edge_translation_sigma = 0.02;
     graph.edge_rotation_sigma = 0.005;
     graph.edge_scale_sigma = 0.01;
+    // A drift of metres (a map whose scale collapsed out of the markers' sight) needs more
+    // than the solver's default 20 iterations (measured: 23 for 19 m); unconverged, the
+    // graph leaves the points torn apart (local BA from 63 px RMS).
+    graph.solver.max_iterations = 100;
     return graph;
   }();
 
@@ -290,6 +307,7 @@ struct SystemStats {
   int num_world_alignments = 0;
   int num_marker_relocalizations = 0;  // tracking restarted from a marker pose
   int num_marker_disagreements = 0;    // keypoint poses rejected by the markers
+  int num_drift_disagreements = 0;     // ... kept instead as drift to correct (first frames)
   int num_map_relocalizations = 0;     // loaded map: restarted from a keyframe match
   PlaceRecognitionStats places;        // relocalisation and loops (with a vocabulary)
   int num_new_maps_after_loss = 0;     // maps started because tracking stayed lost
@@ -391,6 +409,12 @@ class System {
                                   bool* by_map_rotation) const;
   // True when the frame's marker location (world-aligned map) contradicts the pose.
   bool DisagreesWithMarkers(const Rigid3& cam_from_world) const;
+  // A tracked frame whose pose the markers contradict: true when the contradiction is
+  // drift to correct (correct_drift_beyond_gate); the frame then becomes a keyframe.
+  bool TakeDisagreementAsDrift(const Frame& frame, FrameReport& report);
+  // After a tracked or relocalised frame: whether its markers agreed with the pose
+  // (`relocalized`: a relocalisation they did not confirm breaks the tracking's continuity).
+  void NoteMarkerAgreement(const Frame& frame, bool relocalized);
   // Map reuse (system_map_reuse.cc): a frame before the first localisation in a loaded map,
   // and the keyframe-seeded relocalisation (brute-force matching against a few keyframes
   // per frame, pose-only optimisation, then TrackFromPose).
@@ -521,6 +545,13 @@ class System {
   void GuardMarkerKeyframes();
   int next_alignment_anchors_ = 0;  // alignment is tried again at this many anchors
   int lost_with_markers_ = 0;
+  // Timestamp of the last frame whose marker location agreed with its keypoint pose, the map
+  // tracked without a break since (nullopt: not aligned, or broken since); frames kept as
+  // drift since the first one, waiting for the correction; a keyframe wanted for it.
+  std::optional<double> markers_agreed_s_;
+  std::optional<Eigen::Vector3d> last_marker_offset_;  // marker centre - keypoint centre
+  int drift_frames_ = 0;
+  bool drift_keyframe_wanted_ = false;
   std::optional<double> lost_since_s_;  // timestamp of the first lost frame of this loss
   // Closed maps: keypoints only, the biggest one's poses; with markers, the aligned ones'
   // keyframes and points (their poses stay in poses_, frozen).

@@ -214,6 +214,58 @@ bool System::DisagreesWithMarkers(const Rigid3& cam_from_world) const {
   return (centre - fix_->world_from_cam.translation).norm() > options_.max_marker_disagreement_m;
 }
 
+bool System::TakeDisagreementAsDrift(const Frame& frame, FrameReport& report) {
+  if (!options_.correct_drift_beyond_gate || !markers_agreed_s_ || !fix_->known_markers_only) {
+    return false;
+  }
+  const Eigen::Vector3d offset =
+      fix_->world_from_cam.translation - frame.cam_from_world->Inverse().translation;
+  if (drift_frames_ == 0) {
+    // Drift builds up out of the markers' sight or grows a little from frame to frame; a
+    // jump away from where the markers just agreed is a wrong place.
+    const bool long_unseen =
+        frame.timestamp_s - *markers_agreed_s_ >= options_.min_drift_interval_s;
+    const bool gradual =
+        last_marker_offset_ && (offset - *last_marker_offset_).norm() <= options_.max_drift_step_m;
+    if (!long_unseen && !gradual) return false;
+    ARUCOSLAM_LOG_DEBUG(
+        "frame {}: keypoint pose {:.2f} m from the markers' location, {:.1f} s "
+        "after they last agreed: drift, the map is corrected",
+        report.index, offset.norm(), frame.timestamp_s - *markers_agreed_s_);
+    drift_keyframe_wanted_ = true;
+    std::lock_guard lock(stats_mutex_);
+    ++stats_.num_drift_disagreements;
+  }
+  // The correction did not bring the map back in time: from here on a look-alike place.
+  if (++drift_frames_ > options_.max_drift_correction_frames) {
+    markers_agreed_s_.reset();
+    last_marker_offset_.reset();
+    drift_frames_ = 0;
+    drift_keyframe_wanted_ = false;
+    return false;
+  }
+  return true;
+}
+
+void System::NoteMarkerAgreement(const Frame& frame, bool relocalized) {
+  if (!world_aligned_) return;
+  const bool agrees = fix_ && !DisagreesWithMarkers(*frame.cam_from_world);
+  if (relocalized && !agrees) {  // not confirmed by the markers: a break in the tracking
+    markers_agreed_s_.reset();
+    last_marker_offset_.reset();
+    return;
+  }
+  if (fix_) {
+    last_marker_offset_ =
+        fix_->world_from_cam.translation - frame.cam_from_world->Inverse().translation;
+  }
+  if (agrees) {
+    markers_agreed_s_ = frame.timestamp_s;
+    drift_frames_ = 0;
+    drift_keyframe_wanted_ = false;
+  }
+}
+
 bool System::RelocalizeWithMarkers(Frame& frame, FrameReport& report) {
   if (!world_aligned_ || !fix_) return false;
   const TrackingResult result =
@@ -319,6 +371,10 @@ void System::MaybeAlignWorld(Frame* frame) {
                       world_aligned_ ? "re-" : "", world_from_map.scale, alignment.num_inliers,
                       anchors.size(), alignment.rms_m);
   world_aligned_ = true;
+  if (frame != nullptr) {  // the anchors agree with the map
+    markers_agreed_s_ = frame->timestamp_s;
+    last_marker_offset_.reset();
+  }
   rotation_vote_.Clear();
   keep_marker_keyframes_ = false;
   RefreshKeyframePoseCache();

@@ -283,5 +283,69 @@ TEST(SystemMarkers, KeypointPoseThatTheMarkersContradictIsRejected) {
   EXPECT_GE(near_truth, 8);
 }
 
+// Frames 0-39 see the markers where they are; 40-99 see none; from 100 on they are seen as
+// from a camera `shift_m` along x of the truth: to the System, its map drifted that far
+// while no marker was in view (the keypoints, a rigid scene, keep saying otherwise, so a
+// correction can only meet the markers part way).
+struct DriftRun {
+  std::vector<FrameReport> reports;
+  SystemStats stats;
+  Rigid3 shift;
+};
+
+DriftRun RunWithDriftRevealedByMarkers(double shift_m, bool correct_drift) {
+  const CameraModel camera = SceneCamera();
+  SyntheticFeatureScene scene(camera);
+  SystemOptions options;
+  options.marker_map = SceneMarkers();
+  options.keyframes.min_frames_between = 0;
+  options.correct_drift_beyond_gate = correct_drift;
+  System system(camera, options);
+  std::mt19937 rng(7);
+  std::vector<int> truth;
+  DriftRun run;
+  run.shift = Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(shift_m, 0.0, 0.0));
+  for (int t = 0; t < 140; ++t) {
+    const Rigid3 cam_from_world = SceneWorldFromCam(t).Inverse();
+    Frame frame = scene.MakeFrame(FrameId(t), kSceneDt * t, cam_from_world, &truth);
+    std::vector<MarkerDetection> detections;
+    if (t < 40) detections = SceneDetections(SceneMarkers(), camera, cam_from_world, rng);
+    if (t >= 100) {
+      detections = SceneDetections(SceneMarkers(), camera,
+                                   (run.shift * SceneWorldFromCam(t)).Inverse(), rng);
+    }
+    run.reports.push_back(system.ProcessFrame(std::move(frame), detections));
+  }
+  system.Finish();
+  run.stats = system.Stats();
+  return run;
+}
+
+TEST(SystemMarkers, DriftThatTheMarkersRevealAfterAGapIsCorrectedNotRejected) {
+  // 0.6 m of disagreement 3 s after the markers last agreed: drift. The frame keeps its
+  // keypoint pose, becomes a keyframe, and the pose-graph correction moves the map towards
+  // the markers: from then on every frame is tracked within the 0.5 m gate of them.
+  const DriftRun run = RunWithDriftRevealedByMarkers(0.6, /*correct_drift=*/true);
+  EXPECT_EQ(run.stats.num_drift_disagreements, 1);
+  EXPECT_EQ(run.stats.num_marker_disagreements, 0);
+  EXPECT_GE(run.stats.num_marker_corrections, 1);
+  EXPECT_EQ(run.stats.num_resets, 0);
+  ASSERT_TRUE(run.reports[100].cam_from_world);
+  EXPECT_FALSE(run.reports[100].marker_pose);
+  for (int t = 101; t < 140; ++t) {
+    ASSERT_TRUE(run.reports[t].cam_from_world) << t;
+    EXPECT_FALSE(run.reports[t].marker_pose) << t;
+    const Eigen::Vector3d centre = run.reports[t].cam_from_world->Inverse().translation;
+    const Eigen::Vector3d markers = (run.shift * SceneWorldFromCam(t)).translation;
+    EXPECT_LT((centre - markers).norm(), 0.5) << t;
+  }
+}
+
+TEST(SystemMarkers, DriftCorrectionOffRejectsTheSameDisagreement) {
+  const DriftRun run = RunWithDriftRevealedByMarkers(0.6, /*correct_drift=*/false);
+  EXPECT_EQ(run.stats.num_drift_disagreements, 0);
+  EXPECT_GE(run.stats.num_marker_disagreements, 1);
+}
+
 }  // namespace
 }  // namespace arucoslam

@@ -205,6 +205,7 @@ bool System::InitializeFromMarkers(Frame& frame, FrameReport& report) {
   first.cam_from_world = to_world(*first.cam_from_world);
   frame.cam_from_world = to_world(*frame.cam_from_world);
   world_aligned_ = true;
+  markers_agreed_s_ = frame.timestamp_s;
   rotation_vote_.Clear();
   keep_marker_keyframes_ = false;
   RefreshKeyframePoseCache();
