@@ -33,13 +33,6 @@ bool MarkerBundleAdjustmentProblem::Check(std::string* reason) const {
   if (ground_plane_prior && !ground_plane_prior->Check()) {
     return fail("ground-plane prior: sigmas <= 0");
   }
-  if (vehicle_motion_prior && !vehicle_motion_prior->Check()) {
-    return fail("vehicle-motion prior: sigma, acceleration density or gap <= 0");
-  }
-  if (!pose_timestamps_s.empty() && pose_timestamps_s.size() != keypoints.poses.size()) {
-    return fail("pose timestamps: " + std::to_string(pose_timestamps_s.size()) + " for " +
-                std::to_string(keypoints.poses.size()) + " poses");
-  }
   return true;
 }
 

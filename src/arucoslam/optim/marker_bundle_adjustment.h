@@ -12,7 +12,6 @@
 #include "arucoslam/optim/bundle_adjustment.h"
 #include "arucoslam/optim/ground_plane_error.h"
 #include "arucoslam/optim/marker_corner_error.h"
-#include "arucoslam/optim/vehicle_motion_error.h"
 
 namespace arucoslam {
 
@@ -55,13 +54,6 @@ struct MarkerBundleAdjustmentProblem {
   // pose an observation touches gets the GroundPlaneError prior, the plane (height and
   // mounting tilt) estimated with them, starting from the poses' MeanGroundPlane.
   std::optional<GroundPlanePriorOptions> ground_plane_prior;
-  // Set: the poses are one forward-looking vehicle camera's; the poses an observation
-  // touches, in time order (gaps at most max_gap_s), get LateralVelocityError on every two
-  // and ForwardSpeedChangeError on every three. Needs pose_timestamps_s.
-  std::optional<VehicleMotionPriorOptions> vehicle_motion_prior;
-  // Empty, or one time (seconds) per keypoints.poses entry; NaN: not timed (left out of the
-  // vehicle-motion prior).
-  std::vector<double> pose_timestamps_s;
 
   // Everything BundleAdjustmentProblem::Check tests, plus marker indices, sizes and sigmas.
   bool Check(std::string* reason = nullptr) const;

@@ -124,45 +124,6 @@ class GroundPlaneCost : public ceres::SizedCostFunction<3, kPoseSize, 1, 3> {
   GroundPlaneError error_;
 };
 
-class LateralVelocityCost : public ceres::SizedCostFunction<1, kPoseSize, kPoseSize> {
- public:
-  explicit LateralVelocityCost(const LateralVelocityError& error) : error_(error) {}
-  bool Evaluate(const double* const* parameters, double* residuals,
-                double** jacobians) const override {
-    VehicleMotionPoseJacobian d[2];
-    const bool want = jacobians != nullptr;
-    error_.Evaluate(FromBlock(parameters[0]), FromBlock(parameters[1]), residuals,
-                    want ? &d[0] : nullptr, want ? &d[1] : nullptr);
-    for (int k = 0; want && k < 2; ++k) {
-      if (jacobians[k] != nullptr) WritePoseJacobian<1>(d[k], 1.0, jacobians[k]);
-    }
-    return true;
-  }
-
- private:
-  LateralVelocityError error_;
-};
-
-class ForwardSpeedChangeCost : public ceres::SizedCostFunction<1, kPoseSize, kPoseSize, kPoseSize> {
- public:
-  explicit ForwardSpeedChangeCost(const ForwardSpeedChangeError& error) : error_(error) {}
-  bool Evaluate(const double* const* parameters, double* residuals,
-                double** jacobians) const override {
-    VehicleMotionPoseJacobian d[3];
-    const bool want = jacobians != nullptr;
-    error_.Evaluate(FromBlock(parameters[0]), FromBlock(parameters[1]), FromBlock(parameters[2]),
-                    residuals, want ? &d[0] : nullptr, want ? &d[1] : nullptr,
-                    want ? &d[2] : nullptr);
-    for (int k = 0; want && k < 3; ++k) {
-      if (jacobians[k] != nullptr) WritePoseJacobian<1>(d[k], 1.0, jacobians[k]);
-    }
-    return true;
-  }
-
- private:
-  ForwardSpeedChangeError error_;
-};
-
 // Ceres parameter blocks of a problem; `*_used` says which ones a residual touches.
 struct Blocks {
   std::vector<PoseBlock> poses, markers;
@@ -256,40 +217,6 @@ bool AddGroundPlanePrior(const GroundPlanePriorOptions& options, ceres::Manifold
   return true;
 }
 
-// The vehicle-motion prior on the used, timed poses in time order: LateralVelocityError on
-// every two consecutive ones, ForwardSpeedChangeError on every three, wherever each gap is
-// positive and at most max_gap_s. Returns the number of residuals added.
-int AddVehicleMotionPrior(const VehicleMotionPriorOptions& options,
-                          const std::vector<double>& timestamps_s, Blocks* blocks,
-                          ceres::Problem* ceres_problem) {
-  std::vector<std::size_t> timed;
-  for (std::size_t i = 0; i < timestamps_s.size() && i < blocks->poses.size(); ++i) {
-    if (blocks->pose_used[i] && std::isfinite(timestamps_s[i])) timed.push_back(i);
-  }
-  std::stable_sort(timed.begin(), timed.end(),
-                   [&](std::size_t a, std::size_t b) { return timestamps_s[a] < timestamps_s[b]; });
-  const auto gap = [&](std::size_t k) {  // seconds from timed[k - 1] to timed[k]; 0: unlinked
-    const double dt = timestamps_s[timed[k]] - timestamps_s[timed[k - 1]];
-    return dt > 1e-6 && dt <= options.max_gap_s ? dt : 0.0;
-  };
-  const auto block = [&](std::size_t k) { return blocks->poses[timed[k]].data(); };
-  int added = 0;
-  for (std::size_t k = 1; k < timed.size(); ++k) {
-    const double dt2 = gap(k);
-    if (dt2 == 0.0) continue;
-    ceres_problem->AddResidualBlock(new LateralVelocityCost(LateralVelocityError(options, dt2)),
-                                    nullptr, block(k - 1), block(k));
-    ++added;
-    const double dt1 = k >= 2 ? gap(k - 1) : 0.0;
-    if (dt1 == 0.0) continue;
-    ceres_problem->AddResidualBlock(
-        new ForwardSpeedChangeCost(ForwardSpeedChangeError(options, dt1, dt2)), nullptr,
-        block(k - 2), block(k - 1), block(k));
-    ++added;
-  }
-  return added;
-}
-
 void FlagOutliers(const MarkerBundleAdjustmentOptions& options,
                   const MarkerBundleAdjustmentProblem& problem,
                   MarkerBundleAdjustmentSummary* summary) {
@@ -352,10 +279,6 @@ MarkerBundleAdjustmentSummary SolveMarkerBundleAdjustment(
   const bool ground_plane =
       problem->ground_plane_prior &&
       AddGroundPlanePrior(*problem->ground_plane_prior, &sphere, &blocks, &ceres_problem);
-  if (problem->vehicle_motion_prior) {
-    AddVehicleMotionPrior(*problem->vehicle_motion_prior, problem->pose_timestamps_s, &blocks,
-                          &ceres_problem);
-  }
   summary.num_residual_blocks = ceres_problem.NumResidualBlocks();
   if (summary.num_residual_blocks == 0) {
     summary.success = true;

@@ -233,7 +233,6 @@ void System::Initialize(Frame& frame, FrameReport& report) {
   ARUCOSLAM_LOG_DEBUG("frame {}: initialisation {}: {}", report.index,
                       result.success ? "succeeded" : InitFailureName(result.failure),
                       result.message);
-  if (result.success && InitializeFromVehicleModel(frame, result, report)) return;
   if (!result.success) {
     if (result.failure == InitFailure::kTooFewMatches && enough) {
       KeepForBackfill();

@@ -230,16 +230,6 @@ struct SystemOptions {
   double min_marker_init_baseline_m = 0.5;
   // ... and at least this median parallax of the triangulated points (degrees).
   double min_marker_init_parallax_deg = 1.0;
-  // Vehicle initialisation: the camera looks forwards from a wheeled vehicle and is mounted
-  // level (camera y down, along the floor normal). When the free two-view motion leaves the
-  // floor plane by more than vehicle_init_max_off_plane_deg (a narrow baseline trading
-  // turning for sideways motion), the map starts from the vehicle model instead (a turn about
-  // the floor normal, moving along the arc's chord; geometry/vehicle_two_view.h), its
-  // points triangulated with that motion (median parallax at least
-  // min_vehicle_init_parallax_deg) and the motion held in the initial adjustment.
-  bool vehicle_initialization = false;
-  double vehicle_init_max_off_plane_deg = 2.0;
-  double min_vehicle_init_parallax_deg = 0.5;
   // Frames between the initialisation reference and the frame that initialised the map
   // (the camera building up parallax), and before them the frames the previous map lost
   // before it was reset, are tracked backwards against the new map and get poses too (up to
@@ -312,7 +302,6 @@ struct SystemStats {
   PlaceRecognitionStats places;        // relocalisation and loops (with a vocabulary)
   int num_new_maps_after_loss = 0;     // maps started because tracking stayed lost
   int num_marker_initializations = 0;  // maps initialised from two marker locations
-  int num_vehicle_initializations = 0;  // maps initialised from the vehicle model
   int num_maps_discarded = 0;          // closed maps never aligned (marker map only)
   int num_marker_corrections = 0;      // pose-graph corrections of drift by markers
   int num_whole_map_marker_adjustments = 0;  // bundle adjustments of a whole map with markers
@@ -482,10 +471,6 @@ class System {
   // Builds the initial map from the marker poses of the reference and `frame` directly in
   // the world; false when the marker poses do not allow it (the caller initialises as usual).
   bool InitializeFromMarkers(Frame& frame, FrameReport& report);
-  // Vehicle initialisation (SystemOptions::vehicle_initialization) when `free` leaves the
-  // floor plane: true when it decided the frame (map made, or the free motion refused).
-  bool InitializeFromVehicleModel(Frame& frame, const InitializationResult& free,
-                                  FrameReport& report);
   void FinishInitialization(Frame& first, Frame& frame, KeyframeId first_id,
                             KeyframeId second_id, int num_points, FrameReport& report);
   // The frames kept in initialisation_frames_, tracked from `second` back in time with a

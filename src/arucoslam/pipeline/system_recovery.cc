@@ -7,7 +7,6 @@
 
 #include "arucoslam/feature/orb_matcher.h"
 #include "arucoslam/geometry/triangulation.h"
-#include "arucoslam/geometry/vehicle_two_view.h"
 #include "arucoslam/pipeline/system.h"
 #include "arucoslam/slam/map_initialization.h"
 #include "arucoslam/util/logging.h"
@@ -101,50 +100,6 @@ bool System::CloseMap() {
     closed.keyframe_fixes = keyframe_fixes_;
   }
   closed_map_ = std::move(closed);  // an older one not merged stays in the outputs only
-  return true;
-}
-
-bool System::InitializeFromVehicleModel(Frame& frame, const InitializationResult& free,
-                                        FrameReport& report) {
-  if (!options_.vehicle_initialization) return false;
-  const Eigen::Vector3d up(0.0, -1.0, 0.0);  // level camera: y points down
-  const double off_plane_deg =
-      std::asin(std::min(1.0, std::abs(free.cam2_from_cam1.translation.normalized().dot(up)))) *
-      180.0 / std::numbers::pi;
-  if (off_plane_deg <= options_.vehicle_init_max_off_plane_deg) return false;
-  std::vector<Eigen::Vector2d> x1, x2;
-  for (const FeatureMatch& match : free.matches) {
-    x1.push_back(init_reference_->features.undistorted[match.index1]);
-    x2.push_back(frame.features.undistorted[match.index2]);
-  }
-  // The free motion's turn (camera 2 in camera 1) is the search's centre.
-  const double free_turn = TwistAngle(free.cam2_from_cam1.rotation.conjugate(), up);
-  const VehicleTwoViewResult vehicle = SolveVehicleTwoView(x1, x2, up, free_turn, camera_.fx);
-  Frame first = *init_reference_;
-  InitializationResult triangulated =
-      TriangulateWithKnownMotion(first, frame, vehicle.cam2_from_cam1, options_.initializer,
-                                 options_.min_vehicle_init_parallax_deg);
-  ARUCOSLAM_LOG_DEBUG(
-      "frame {}: free motion {:.1f} deg off the floor plane; vehicle model: turn {:.2f} deg "
-      "(free {:.2f}), {} of {} matches within the error bound, {}",
-      report.index, off_plane_deg, vehicle.angle_rad * 180.0 / std::numbers::pi,
-      free_turn * 180.0 / std::numbers::pi, vehicle.num_inliers, x1.size(), triangulated.message);
-  // The free motion is not trusted off the plane: refused if the vehicle model fails too.
-  const auto refuse = [&](const std::string& why) {
-    KeepForBackfill(frame);
-    report.message = "initialisation off the floor plane: " + why;
-    return true;
-  };
-  if (!triangulated.success) return refuse(triangulated.message);
-  ScaleToUnitMedianDepth(&triangulated);  // the free initialiser's gauge
-  InitialMapOptions held = options_.initial_map;
-  held.hold_motion = true;
-  const InitialMapResult created = CreateInitialMap(*map_, first, frame, triangulated, held);
-  if (!created.success) return refuse(created.message);
-  FinishInitialization(first, frame, created.first, created.second, created.num_points, report);
-  report.message += " (vehicle model)";
-  std::lock_guard lock(stats_mutex_);
-  ++stats_.num_vehicle_initializations;
   return true;
 }
 

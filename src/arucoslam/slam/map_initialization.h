@@ -14,7 +14,7 @@ struct InitialMapOptions {
   // After refinement the map is rejected when fewer points than this keep both views inside
   // the chi-square test (the tracker needs that many to continue).
   int min_points = 50;
-  // The motion between the two keyframes is known (markers, a vehicle model): refinement
+  // The motion between the two keyframes is known (e.g. from two marker poses): refinement
   // moves the points only.
   bool hold_motion = false;
 

@@ -54,10 +54,6 @@ struct MarkerMapperOptions {
   // adjustment of the whole map (Refine) holds every keyframe near one plane (height and
   // mounting tilt estimated with them; GroundPlaneError). Local BA does not use it.
   std::optional<GroundPlanePriorOptions> ground_plane_prior;
-  // Set: the camera looks forwards from a wheeled vehicle, and Refine holds the map's
-  // keyframes, in time order, to its motion (no sideways slip, bounded forward acceleration;
-  // vehicle_motion_error.h). Local BA does not use it.
-  std::optional<VehicleMotionPriorOptions> vehicle_motion_prior;
 
   bool Check() const {
     return unknown_marker_size_m >= 0.0 && marker_pose.Check() && max_initial_rms_px > 0.0 &&
@@ -65,8 +61,7 @@ struct MarkerMapperOptions {
            max_view_disagreement_fraction >= 0.0 && max_pending_views >= min_consistent_views &&
            corner_sigma_px > 0.0 && min_corner_sigma_px > 0.0 &&
            max_corner_sigma_px >= min_corner_sigma_px && bundle_adjustment.Check() &&
-           (!ground_plane_prior || ground_plane_prior->Check()) &&
-           (!vehicle_motion_prior || vehicle_motion_prior->Check());
+           (!ground_plane_prior || ground_plane_prior->Check());
   }
 };
 

@@ -1,7 +1,6 @@
 // MarkerMapper's bundle adjustments: one new marker against its views, the mapped markers
 // against the recorded poses, and the whole map with every marker view (retired ones too).
 #include <cmath>
-#include <limits>
 #include <map>
 #include <optional>
 #include <utility>
@@ -50,7 +49,6 @@ MarkerBundleAdjustmentProblem MarkerMapper::BuildProblem(const MapData* map,
   if (map != nullptr) {
     for (const auto& [id, keyframe] : map->keyframes()) {
       add_keyframe(id, keyframe.cam_from_world, keyframe.camera, false);
-      problem.pose_timestamps_s.push_back(keyframe.timestamp_s);
     }
     std::map<MapPointId, std::size_t> point_index;
     for (const auto& [id, point] : map->map_points()) {
@@ -134,12 +132,6 @@ MarkerBundleAdjustmentSummary MarkerMapper::Refine(MapData* map) {
   ProblemIndex index;
   MarkerBundleAdjustmentProblem problem = BuildProblem(map, &index);
   problem.ground_plane_prior = options_.ground_plane_prior;
-  problem.vehicle_motion_prior = options_.vehicle_motion_prior;
-  // Retired views are not timed; the live keyframes' times were set in BuildProblem.
-  if (!problem.pose_timestamps_s.empty()) {
-    problem.pose_timestamps_s.resize(problem.keypoints.poses.size(),
-                                     std::numeric_limits<double>::quiet_NaN());
-  }
   MarkerBundleAdjustmentSummary summary =
       SolveMarkerBundleAdjustment(options_.bundle_adjustment, &problem);
   if (!summary.success) return summary;
