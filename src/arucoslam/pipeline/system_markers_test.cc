@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <optional>
@@ -117,6 +118,15 @@ TEST(SystemMarkers, OptionsCheck) {
   EXPECT_TRUE(options.Check());
   options.min_alignment_anchors = 1;
   EXPECT_FALSE(options.Check());
+  for (const auto& breaks : std::vector<std::function<void(SystemOptions*)>>{
+           [](SystemOptions* o) { o->min_drift_interval_s = -1.0; },
+           [](SystemOptions* o) { o->max_drift_step_m = -0.1; },
+           [](SystemOptions* o) { o->max_drift_correction_frames = 0; }}) {
+    SystemOptions drift;
+    drift.marker_map = SceneMarkers();
+    breaks(&drift);
+    EXPECT_FALSE(drift.Check());
+  }
 }
 
 TEST(SystemMarkers, BlockingRunIsInTheWorldFrameWithMetricScale) {
@@ -283,36 +293,35 @@ TEST(SystemMarkers, KeypointPoseThatTheMarkersContradictIsRejected) {
   EXPECT_GE(near_truth, 8);
 }
 
-// Frames 0-39 see the markers where they are; 40-99 see none; from 100 on they are seen as
-// from a camera `shift_m` along x of the truth: to the System, its map drifted that far
-// while no marker was in view (the keypoints, a rigid scene, keep saying otherwise, so a
-// correction can only meet the markers part way).
+// Frame t sees the markers as from a camera shift_at(t) metres along x of the truth (none
+// when nullopt): to the System, its map drifted that far. The keypoints, a rigid scene, keep
+// saying otherwise, so a correction can only meet the markers part way.
+using MarkerShift = std::function<std::optional<double>(int t)>;
 struct DriftRun {
   std::vector<FrameReport> reports;
   SystemStats stats;
-  Rigid3 shift;
 };
 
-DriftRun RunWithDriftRevealedByMarkers(double shift_m, bool correct_drift) {
+DriftRun RunWithShiftedMarkers(const MarkerShift& shift_at,
+                               const std::function<void(SystemOptions*)>& configure = {}) {
   const CameraModel camera = SceneCamera();
   SyntheticFeatureScene scene(camera);
   SystemOptions options;
   options.marker_map = SceneMarkers();
   options.keyframes.min_frames_between = 0;
-  options.correct_drift_beyond_gate = correct_drift;
+  if (configure) configure(&options);
   System system(camera, options);
   std::mt19937 rng(7);
   std::vector<int> truth;
   DriftRun run;
-  run.shift = Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(shift_m, 0.0, 0.0));
   for (int t = 0; t < 140; ++t) {
     const Rigid3 cam_from_world = SceneWorldFromCam(t).Inverse();
     Frame frame = scene.MakeFrame(FrameId(t), kSceneDt * t, cam_from_world, &truth);
     std::vector<MarkerDetection> detections;
-    if (t < 40) detections = SceneDetections(SceneMarkers(), camera, cam_from_world, rng);
-    if (t >= 100) {
+    if (const std::optional<double> shift = shift_at(t)) {
+      const Rigid3 seen_from(Eigen::Quaterniond::Identity(), Eigen::Vector3d(*shift, 0.0, 0.0));
       detections = SceneDetections(SceneMarkers(), camera,
-                                   (run.shift * SceneWorldFromCam(t)).Inverse(), rng);
+                                   (seen_from * SceneWorldFromCam(t)).Inverse(), rng);
     }
     run.reports.push_back(system.ProcessFrame(std::move(frame), detections));
   }
@@ -321,11 +330,25 @@ DriftRun RunWithDriftRevealedByMarkers(double shift_m, bool correct_drift) {
   return run;
 }
 
+// Markers where they are in frames 0-39, none in 40-99, then seen 0.6 m off.
+std::optional<double> ShiftAfterGap(int t) {
+  if (t < 40) return 0.0;
+  if (t < 100) return std::nullopt;
+  return 0.6;
+}
+
+// Distance from frame t's reported camera centre to where its markers put it.
+double DistanceFromMarkers(const DriftRun& run, const MarkerShift& shift_at, int t) {
+  const Eigen::Vector3d centre = run.reports[t].cam_from_world->Inverse().translation;
+  return (centre - SceneWorldFromCam(t).translation - Eigen::Vector3d(*shift_at(t), 0.0, 0.0))
+      .norm();
+}
+
 TEST(SystemMarkers, DriftThatTheMarkersRevealAfterAGapIsCorrectedNotRejected) {
   // 0.6 m of disagreement 3 s after the markers last agreed: drift. The frame keeps its
   // keypoint pose, becomes a keyframe, and the pose-graph correction moves the map towards
   // the markers: from then on every frame is tracked within the 0.5 m gate of them.
-  const DriftRun run = RunWithDriftRevealedByMarkers(0.6, /*correct_drift=*/true);
+  const DriftRun run = RunWithShiftedMarkers(ShiftAfterGap);
   EXPECT_EQ(run.stats.num_drift_disagreements, 1);
   EXPECT_EQ(run.stats.num_marker_disagreements, 0);
   EXPECT_GE(run.stats.num_marker_corrections, 1);
@@ -335,14 +358,42 @@ TEST(SystemMarkers, DriftThatTheMarkersRevealAfterAGapIsCorrectedNotRejected) {
   for (int t = 101; t < 140; ++t) {
     ASSERT_TRUE(run.reports[t].cam_from_world) << t;
     EXPECT_FALSE(run.reports[t].marker_pose) << t;
-    const Eigen::Vector3d centre = run.reports[t].cam_from_world->Inverse().translation;
-    const Eigen::Vector3d markers = (run.shift * SceneWorldFromCam(t)).translation;
-    EXPECT_LT((centre - markers).norm(), 0.5) << t;
+    EXPECT_LT(DistanceFromMarkers(run, ShiftAfterGap, t), 0.5) << t;
   }
 }
 
 TEST(SystemMarkers, DriftCorrectionOffRejectsTheSameDisagreement) {
-  const DriftRun run = RunWithDriftRevealedByMarkers(0.6, /*correct_drift=*/false);
+  const DriftRun run = RunWithShiftedMarkers(
+      ShiftAfterGap, [](SystemOptions* options) { options->correct_drift_beyond_gate = false; });
+  EXPECT_EQ(run.stats.num_drift_disagreements, 0);
+  EXPECT_GE(run.stats.num_marker_disagreements, 1);
+}
+
+// Markers in view all along, seen 5 cm further off each frame from frame 60 (1.5 m by 90):
+// faster than the corrections at each keyframe bring the map back.
+std::optional<double> GrowingShift(int t) { return t < 60 ? 0.0 : std::min(1.5, 0.05 * (t - 60)); }
+
+TEST(SystemMarkers, DisagreementGrowingFrameByFrameIsDrift) {
+  // It passes the 0.5 m gate right after the markers agreed, but by at most 5 cm since the
+  // previous frame: drift. The map follows the markers instead of being rejected; by frame
+  // 120 it is back within the gate of them, more than 1 m from where the keypoints put it.
+  const DriftRun run = RunWithShiftedMarkers(GrowingShift);
+  EXPECT_GE(run.stats.num_drift_disagreements, 1);
+  EXPECT_EQ(run.stats.num_marker_disagreements, 0);
+  EXPECT_EQ(run.stats.num_resets, 0);
+  for (int t = 60; t < 140; ++t) {
+    ASSERT_TRUE(run.reports[t].cam_from_world) << t;
+    EXPECT_FALSE(run.reports[t].marker_pose) << t;
+    if (t < 120) continue;
+    EXPECT_LT(DistanceFromMarkers(run, GrowingShift, t), 0.5) << t;
+    const Eigen::Vector3d centre = run.reports[t].cam_from_world->Inverse().translation;
+    EXPECT_GT((centre - SceneWorldFromCam(t).translation).norm(), 1.0) << t;
+  }
+}
+
+TEST(SystemMarkers, DisagreementGrowingFrameByFrameIsRejectedWithoutTheStepRule) {
+  const DriftRun run = RunWithShiftedMarkers(
+      GrowingShift, [](SystemOptions* options) { options->max_drift_step_m = 0.0; });
   EXPECT_EQ(run.stats.num_drift_disagreements, 0);
   EXPECT_GE(run.stats.num_marker_disagreements, 1);
 }
