@@ -394,7 +394,11 @@ void System::MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& rep
     mapping_busy_ = true;
     if (queue_->Push(keyframe)) {
       ++keyframes_queued_;
-      if (static_cast<int>(map_->NumKeyframes()) <= options_.synchronous_young_map_keyframes) {
+      const bool young =
+          static_cast<int>(map_->NumKeyframes()) <= options_.synchronous_young_map_keyframes;
+      const bool unaligned =
+          options_.marker_map && !world_aligned_ && options_.synchronous_until_aligned;
+      if (young || unaligned) {
         WaitForMapping();
       }
     }

@@ -59,6 +59,11 @@ struct SystemOptions {
   // demo sequence ended its first local BAs at 4-7 px RMS and lost four fifths of its scale
   // before it saw a marker (blocking: 1.4-3.7 px). 0: tracking never waits.
   int synchronous_young_map_keyframes = 20;
+  // With a marker map: also every keyframe of a map not yet aligned to the marker world (its
+  // scale is anchored only once it is). Demo sequence, threaded, --ground-vehicle: world ATE
+  // 0.141-0.152 m in three runs instead of 0.37-2.32 m (map 2 aligned at scale 9.1 every
+  // time instead of 10-34), for 93-102 s of wall time instead of 40-45 s (BENCHMARKS.md).
+  bool synchronous_until_aligned = true;
   // The initialisation reference frame is replaced when the current frame is more than this
   // many seconds later (a reference is also replaced when too few matches are left). Long
   // enough for a vehicle that starts from rest to build up parallax.
