@@ -388,6 +388,9 @@ void System::MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& rep
     std::lock_guard lock(stats_mutex_);
     ++stats_.num_keyframes_inserted;
   }
+  // The marker location is stored before the keyframe is queued: the mapping thread's drift
+  // correction reads it.
+  AddAnchor(keyframe, fix_);
   if (options_.blocking) {
     pending_keyframe_ = keyframe;  // mapped once the frame's tracking time is recorded
   } else {
@@ -403,7 +406,6 @@ void System::MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& rep
       }
     }
   }
-  AddAnchor(keyframe, fix_);
   MaybeAlignWorld(&frame);
 }
 

@@ -396,6 +396,22 @@ TEST(SystemMarkers, DriftThatTheMarkersRevealAfterAGapIsCorrectedNotRejected) {
   }
 }
 
+TEST(SystemMarkers, ThreadedDriftCorrectionSeesTheKeyframesMarkers) {
+  // Threaded, each keyframe mapped before the next frame: the mapping thread corrects the
+  // drift only if the keyframe's marker location was stored before the keyframe was queued.
+  const DriftRun run = RunWithShiftedMarkers(ShiftAfterGap, [](SystemOptions* options) {
+    options->blocking = false;
+    options->synchronous_young_map_keyframes = 1000;
+  });
+  EXPECT_EQ(run.stats.num_drift_disagreements, 1);
+  EXPECT_EQ(run.stats.num_marker_disagreements, 0);
+  EXPECT_GE(run.stats.num_marker_corrections, 1);
+  for (int t = 101; t < 140; ++t) {
+    ASSERT_TRUE(run.reports[t].cam_from_world) << t;
+    EXPECT_LT(DistanceFromMarkers(run, ShiftAfterGap, t), 0.5) << t;
+  }
+}
+
 TEST(SystemMarkers, DriftCorrectionOffRejectsTheSameDisagreement) {
   const DriftRun run = RunWithShiftedMarkers(
       ShiftAfterGap, [](SystemOptions* options) { options->correct_drift_beyond_gate = false; });
