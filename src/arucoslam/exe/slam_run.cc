@@ -51,6 +51,8 @@ SlamRunStats MakeStats(const std::string& dataset_label, const Dataset& dataset,
   out.marker_only_poses = stats.num_marker_only_poses;
   out.world_alignments = stats.num_world_alignments;
   out.marker_drift_corrections = stats.num_marker_corrections;
+  out.marker_rejections = stats.num_marker_disagreements;
+  out.drift_beyond_gate = stats.num_drift_disagreements;
   out.whole_map_marker_adjustments = stats.num_whole_map_marker_adjustments;
   out.map_merges = stats.num_map_merges;
   out.wall_time_s = wall_time_s;

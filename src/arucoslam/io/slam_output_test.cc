@@ -42,6 +42,8 @@ TEST(SlamOutput, WritesFourFilesThatReadBack) {
   stats.markers = true;
   stats.whole_map_marker_adjustments = 2;
   stats.map_merges = 1;
+  stats.marker_rejections = 4;
+  stats.drift_beyond_gate = 6;
   stats.refined_frame_poses = 17;
   stats.inconsistent_poses = 5;
   stats.map_rotation_disambiguations = 3;
@@ -62,6 +64,8 @@ TEST(SlamOutput, WritesFourFilesThatReadBack) {
   EXPECT_NE(json.find("\"tracked_fraction\": 0.8"), std::string::npos);
   EXPECT_NE(json.find("\"whole_map_adjustments\": 2"), std::string::npos);
   EXPECT_NE(json.find("\"map_merges\": 1"), std::string::npos);
+  EXPECT_NE(json.find("\"rejected_keypoint_poses\": 4"), std::string::npos);
+  EXPECT_NE(json.find("\"drift_beyond_gate\": 6"), std::string::npos);
   EXPECT_NE(json.find("\"refined_frame_poses\": 17"), std::string::npos);
   EXPECT_NE(json.find("\"left_out\": 5"), std::string::npos);
   EXPECT_NE(json.find("\"disambiguated_by_map_rotation\": 3"), std::string::npos);
