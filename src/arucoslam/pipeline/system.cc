@@ -298,9 +298,7 @@ void System::Track(Frame& frame, FrameReport& report) {
   if (result.state == TrackingState::kTracking && frame.cam_from_world &&
       DisagreesWithMarkers(*frame.cam_from_world) && !TakeDisagreementAsDrift(frame, report)) {
     ARUCOSLAM_LOG_DEBUG("frame {}: keypoint pose {:.2f} m from the markers' location, rejected",
-                        report.index,
-                        (frame.cam_from_world->Inverse().translation -
-                         fix_->world_from_cam.translation).norm());
+                        report.index, MarkerOffset(*frame.cam_from_world).norm());
     tracker_->MarkLost();
     frame.cam_from_world.reset();
     result.state = TrackingState::kLost;
@@ -488,10 +486,7 @@ void System::ResetMap() {
   bridge_priors_.clear();
   lost_with_markers_ = 0;
   lost_since_s_.reset();
-  markers_agreed_s_.reset();
-  last_marker_offset_.reset();
-  drift_frames_ = 0;
-  drift_keyframe_wanted_ = false;
+  ForgetMarkerAgreement();
   last_state_ = TrackingState::kNotInitialized;
   mapping_busy_ = false;
   StartMappingThread();

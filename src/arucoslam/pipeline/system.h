@@ -61,8 +61,8 @@ struct SystemOptions {
   int synchronous_young_map_keyframes = 20;
   // With a marker map: also every keyframe of a map not yet aligned to the marker world (its
   // scale is anchored only once it is). Demo sequence, threaded, --ground-vehicle: world ATE
-  // 0.141-0.152 m in three runs instead of 0.37-2.32 m (map 2 aligned at scale 9.1 every
-  // time instead of 10-34), for 93-102 s of wall time instead of 40-45 s (BENCHMARKS.md).
+  // 0.137-0.191 m in five runs instead of 0.37-2.32 m (map 2 aligned at scale 9.1 instead of
+  // 10-34), for 93-102 s of wall time instead of 40-45 s (BENCHMARKS.md).
   bool synchronous_until_aligned = true;
   // The initialisation reference frame is replaced when the current frame is more than this
   // many seconds later (a reference is also replaced when too few matches are left). Long
@@ -401,6 +401,8 @@ class System {
   // `by_map_rotation`: settled by the unaligned map's voted orientation alone.
   AmbiguityChoice ResolveByMotion(const CameraLocation& location, double timestamp_s,
                                   bool* by_map_rotation) const;
+  // The frame's marker location minus the camera centre of `cam_from_world` (needs fix_).
+  Eigen::Vector3d MarkerOffset(const Rigid3& cam_from_world) const;
   // True when the frame's marker location (world-aligned map) contradicts the pose.
   bool DisagreesWithMarkers(const Rigid3& cam_from_world) const;
   // A tracked frame whose pose the markers contradict: true when the contradiction is
@@ -409,6 +411,8 @@ class System {
   // After a tracked or relocalised frame: whether its markers agreed with the pose
   // (`relocalized`: a relocalisation they did not confirm breaks the tracking's continuity).
   void NoteMarkerAgreement(const Frame& frame, bool relocalized);
+  // Ends the tracking's continuity with its markers (and any drift being corrected).
+  void ForgetMarkerAgreement();
   // Map reuse (system_map_reuse.cc): a frame before the first localisation in a loaded map,
   // and the keyframe-seeded relocalisation (brute-force matching against a few keyframes
   // per frame, pose-only optimisation, then TrackFromPose).
@@ -539,7 +543,7 @@ class System {
   // tracked without a break since (nullopt: not aligned, or broken since); frames kept as
   // drift since the first one, waiting for the correction; a keyframe wanted for it.
   std::optional<double> markers_agreed_s_;
-  std::optional<Eigen::Vector3d> last_marker_offset_;  // marker centre - keypoint centre
+  std::optional<Eigen::Vector3d> last_marker_offset_;  // MarkerOffset at the last fix
   int drift_frames_ = 0;
   bool drift_keyframe_wanted_ = false;
   std::optional<double> lost_since_s_;  // timestamp of the first lost frame of this loss

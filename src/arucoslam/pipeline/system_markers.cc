@@ -208,18 +208,27 @@ void System::GuardMarkerKeyframes() {
   });
 }
 
+Eigen::Vector3d System::MarkerOffset(const Rigid3& cam_from_world) const {
+  return fix_->world_from_cam.translation - cam_from_world.Inverse().translation;
+}
+
 bool System::DisagreesWithMarkers(const Rigid3& cam_from_world) const {
   if (!world_aligned_ || !fix_) return false;
-  const Eigen::Vector3d centre = cam_from_world.Inverse().translation;
-  return (centre - fix_->world_from_cam.translation).norm() > options_.max_marker_disagreement_m;
+  return MarkerOffset(cam_from_world).norm() > options_.max_marker_disagreement_m;
+}
+
+void System::ForgetMarkerAgreement() {
+  markers_agreed_s_.reset();
+  last_marker_offset_.reset();
+  drift_frames_ = 0;
+  drift_keyframe_wanted_ = false;
 }
 
 bool System::TakeDisagreementAsDrift(const Frame& frame, FrameReport& report) {
   if (!options_.correct_drift_beyond_gate || !markers_agreed_s_ || !fix_->known_markers_only) {
     return false;
   }
-  const Eigen::Vector3d offset =
-      fix_->world_from_cam.translation - frame.cam_from_world->Inverse().translation;
+  const Eigen::Vector3d offset = MarkerOffset(*frame.cam_from_world);
   if (drift_frames_ == 0) {
     // Drift builds up out of the markers' sight or grows a little from frame to frame; a
     // jump away from where the markers just agreed is a wrong place.
@@ -238,10 +247,7 @@ bool System::TakeDisagreementAsDrift(const Frame& frame, FrameReport& report) {
   }
   // The correction did not bring the map back in time: from here on a look-alike place.
   if (++drift_frames_ > options_.max_drift_correction_frames) {
-    markers_agreed_s_.reset();
-    last_marker_offset_.reset();
-    drift_frames_ = 0;
-    drift_keyframe_wanted_ = false;
+    ForgetMarkerAgreement();
     return false;
   }
   return true;
@@ -251,14 +257,10 @@ void System::NoteMarkerAgreement(const Frame& frame, bool relocalized) {
   if (!world_aligned_) return;
   const bool agrees = fix_ && !DisagreesWithMarkers(*frame.cam_from_world);
   if (relocalized && !agrees) {  // not confirmed by the markers: a break in the tracking
-    markers_agreed_s_.reset();
-    last_marker_offset_.reset();
+    ForgetMarkerAgreement();
     return;
   }
-  if (fix_) {
-    last_marker_offset_ =
-        fix_->world_from_cam.translation - frame.cam_from_world->Inverse().translation;
-  }
+  if (fix_) last_marker_offset_ = MarkerOffset(*frame.cam_from_world);
   if (agrees) {
     markers_agreed_s_ = frame.timestamp_s;
     drift_frames_ = 0;
