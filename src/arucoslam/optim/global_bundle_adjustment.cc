@@ -45,7 +45,8 @@ int EraseOutliers(MapData& data, const GlobalBundleAdjustmentSnapshot& snapshot,
 
 GlobalBundleAdjustmentSnapshot TakeGlobalSnapshot(const MapData& data,
                                                   const GlobalBundleAdjustmentOptions& options,
-                                                  const MarkerLandmarks* landmarks) {
+                                                  const MarkerLandmarks* landmarks,
+                                                  const std::vector<KeyframePosePrior>& priors) {
   GlobalBundleAdjustmentSnapshot snapshot;
   std::map<KeyframeId, std::size_t> pose_index;
   for (const auto& [id, keyframe] : data.keyframes()) {
@@ -74,6 +75,7 @@ GlobalBundleAdjustmentSnapshot TakeGlobalSnapshot(const MapData& data,
   if (landmarks != nullptr) {
     snapshot.markers =
         CollectMarkerFactors(data, snapshot.keyframe_ids, *landmarks, options.markers);
+    snapshot.markers.position_priors = PositionPriorsOf(priors, snapshot.keyframe_ids);
     if (snapshot.markers.num_fixed_markers > 0) {
       for (auto& pose : snapshot.problem.poses) pose.fixed = false;
     }

@@ -50,10 +50,10 @@ struct GlobalBundleAdjustmentResult {
 };
 
 // With `landmarks`, every keyframe's views of them join the problem (read the landmarks
-// while nothing edits them).
-GlobalBundleAdjustmentSnapshot TakeGlobalSnapshot(const MapData& data,
-                                                  const GlobalBundleAdjustmentOptions& options,
-                                                  const MarkerLandmarks* landmarks = nullptr);
+// while nothing edits them), and so do the centres of `priors` (PositionPriorsOf).
+GlobalBundleAdjustmentSnapshot TakeGlobalSnapshot(
+    const MapData& data, const GlobalBundleAdjustmentOptions& options,
+    const MarkerLandmarks* landmarks = nullptr, const std::vector<KeyframePosePrior>& priors = {});
 
 // Solves the snapshot in place (keypoints, and marker corners when it has marker factors).
 BundleAdjustmentSummary SolveGlobalSnapshot(const GlobalBundleAdjustmentOptions& options,

@@ -30,6 +30,14 @@ bool MarkerBundleAdjustmentProblem::Check(std::string* reason) const {
       return fail("marker observation " + std::to_string(i) + ": sigma <= 0");
     }
   }
+  for (std::size_t i = 0; i < position_priors.size(); ++i) {
+    if (position_priors[i].pose_index >= keypoints.poses.size()) {
+      return fail("position prior " + std::to_string(i) + ": index out of range");
+    }
+    if (!(position_priors[i].sigma_m > 0.0)) {
+      return fail("position prior " + std::to_string(i) + ": sigma <= 0");
+    }
+  }
   if (ground_plane_prior && !ground_plane_prior->Check()) {
     return fail("ground-plane prior: sigmas <= 0");
   }
@@ -94,6 +102,10 @@ std::string MarkerBundleAdjustmentSummary::BriefReport() const {
       << final_marker_rms_px << " px, outliers " << num_keypoint_outliers << " keypoint / "
       << num_marker_outliers << " marker, ";
   if (corner_sigma_px > 0.0) out << "corners weighted at " << corner_sigma_px << " px, ";
+  if (num_position_priors > 0) {
+    out << num_position_priors << " position priors (at most " << max_position_prior_sigmas
+        << " sigma off), ";
+  }
   if (ground_plane) {
     const double tilt_deg =
         std::acos(std::clamp(-ground_plane->up_in_camera.y(), -1.0, 1.0)) * 180.0 / M_PI;

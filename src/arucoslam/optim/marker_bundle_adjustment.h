@@ -12,6 +12,7 @@
 #include "arucoslam/optim/bundle_adjustment.h"
 #include "arucoslam/optim/ground_plane_error.h"
 #include "arucoslam/optim/marker_corner_error.h"
+#include "arucoslam/optim/position_prior_error.h"
 
 namespace arucoslam {
 
@@ -54,6 +55,9 @@ struct MarkerBundleAdjustmentProblem {
   // pose an observation touches gets the GroundPlaneError prior, the plane (height and
   // mounting tilt) estimated with them, starting from the poses' MeanGroundPlane.
   std::optional<GroundPlanePriorOptions> ground_plane_prior;
+  // Soft priors on camera centres (e.g. the bridge over a tracking gap); pose_index into
+  // keypoints.poses.
+  std::vector<PositionPrior> position_priors;
 
   // Everything BundleAdjustmentProblem::Check tests, plus marker indices, sizes and sigmas.
   bool Check(std::string* reason = nullptr) const;
@@ -70,6 +74,10 @@ struct MarkerBundleAdjustmentSummary {
   double initial_marker_rms_px = 0.0;  // unweighted RMS over all marker corners
   double final_marker_rms_px = 0.0;
   double corner_sigma_px = 0.0;  // set when the caller re-weighted the corners (else 0)
+  // Position priors in the solve (on poses an observation uses) and, after it, the largest
+  // distance of such a camera from its prior, in the prior's sigmas.
+  int num_position_priors = 0;
+  double max_position_prior_sigmas = 0.0;
   double solve_seconds = 0.0;
   std::vector<bool> keypoint_outliers;  // per keypoint observation, chi-square 2 dof
   std::vector<bool> marker_outliers;    // per marker observation, chi-square 8 dof

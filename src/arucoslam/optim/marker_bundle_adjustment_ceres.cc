@@ -124,6 +124,25 @@ class GroundPlaneCost : public ceres::SizedCostFunction<3, kPoseSize, 1, 3> {
   GroundPlaneError error_;
 };
 
+class PositionPriorCost : public ceres::SizedCostFunction<3, kPoseSize> {
+ public:
+  explicit PositionPriorCost(const PositionPrior& prior) : error_(prior) {}
+  bool Evaluate(const double* const* parameters, double* residuals,
+                double** jacobians) const override {
+    Eigen::Vector3d residual;
+    PositionPriorPoseJacobian d_pose;
+    const bool want = jacobians != nullptr && jacobians[0] != nullptr;
+    error_.Evaluate(FromBlock(parameters[0]), &residual, want ? &d_pose : nullptr);
+    Eigen::Map<Eigen::Vector3d> whitened(residuals);
+    whitened = residual;
+    if (want) WritePoseJacobian<3>(d_pose, 1.0, jacobians[0]);
+    return true;
+  }
+
+ private:
+  PositionPriorError error_;
+};
+
 // Ceres parameter blocks of a problem; `*_used` says which ones a residual touches.
 struct Blocks {
   std::vector<PoseBlock> poses, markers;
@@ -193,6 +212,12 @@ void AddResiduals(const MarkerBundleAdjustmentProblem& problem, ceres::Manifold*
         blocks->pose_used[observation.pose_index], ceres_problem);
     Use(marker_block, marker.fixed, manifold, blocks->marker_used[observation.marker_index],
         ceres_problem);
+  }
+  // Only on poses an observation ties to the rest: a prior alone would just be met.
+  for (const PositionPrior& prior : problem.position_priors) {
+    if (!blocks->pose_used[prior.pose_index]) continue;
+    ceres_problem->AddResidualBlock(new PositionPriorCost(prior), nullptr,
+                                    blocks->poses[prior.pose_index].data());
   }
 }
 
@@ -320,6 +345,15 @@ MarkerBundleAdjustmentSummary SolveMarkerBundleAdjustment(
   }
   summary.final_keypoint_rms_px = ReprojectionRmsPixels(problem->keypoints);
   summary.final_marker_rms_px = MarkerReprojectionRmsPixels(*problem);
+  for (const PositionPrior& prior : problem->position_priors) {
+    if (!blocks.pose_used[prior.pose_index]) continue;
+    Eigen::Vector3d residual;
+    PositionPriorError(prior).Evaluate(problem->keypoints.poses[prior.pose_index].cam_from_world,
+                                       &residual);
+    ++summary.num_position_priors;
+    summary.max_position_prior_sigmas =
+        std::max(summary.max_position_prior_sigmas, residual.norm());
+  }
   FlagOutliers(options, *problem, &summary);
   summary.solve_seconds = stopwatch.ElapsedSeconds();
   return summary;

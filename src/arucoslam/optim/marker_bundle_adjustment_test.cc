@@ -102,6 +102,46 @@ TEST(MarkerBundleAdjustmentTest, WithoutMarkersTheScaleErrorStays) {
   EXPECT_GT(MaxCentreError(problem, truth), 0.2);
 }
 
+TEST(MarkerBundleAdjustmentTest, PositionPriorOnTheLastCameraTakesTheScaleErrorOut) {
+  // The start of the test above, plus where the last camera is (the bridge over a tracking
+  // gap gives that for a map's first keyframe). The held first pose is at its true place, so
+  // what the keypoints leave free is the scale about it, which the prior fixes.
+  const MarkerBundleAdjustmentProblem truth = MakeSyntheticMarkerScene(NoisyScene());
+  MarkerBundleAdjustmentProblem start = truth;
+  Distort(Sim3(1.08, Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero()), 0.005, &start);
+  start.marker_observations.clear();
+  start.keypoints.poses[0] = {truth.keypoints.poses[0].cam_from_world, true};
+  MarkerBundleAdjustmentOptions options;
+  options.solver.max_iterations = 50;
+
+  MarkerBundleAdjustmentProblem without = start;
+  ASSERT_TRUE(SolveMarkerBundleAdjustment(options, &without).success);
+  EXPECT_GT(MaxCentreError(without, truth), 0.2);
+
+  MarkerBundleAdjustmentProblem with = start;
+  const std::size_t last = with.keypoints.poses.size() - 1;
+  with.position_priors.push_back({last, Centre(truth.keypoints.poses[last].cam_from_world), 0.02});
+  const MarkerBundleAdjustmentSummary summary = SolveMarkerBundleAdjustment(options, &with);
+  ASSERT_TRUE(summary.success) << summary.message;
+  EXPECT_EQ(summary.num_position_priors, 1);
+  EXPECT_LT(summary.max_position_prior_sigmas, 1.0);
+  EXPECT_LT(MaxCentreError(with, truth), 0.03) << MaxCentreError(without, truth);
+}
+
+TEST(MarkerBundleAdjustmentTest, PositionPriorsAreChecked) {
+  MarkerBundleAdjustmentProblem problem = MakeSyntheticMarkerScene(NoisyScene());
+  problem.position_priors.push_back({problem.keypoints.poses.size(), Eigen::Vector3d::Zero(), 0.1});
+  MarkerBundleAdjustmentSummary summary = SolveMarkerBundleAdjustment({}, &problem);
+  EXPECT_FALSE(summary.success);
+  EXPECT_NE(summary.message.find("position prior 0: index out of range"), std::string::npos)
+      << summary.message;
+  problem.position_priors.front() = {0, Eigen::Vector3d::Zero(), 0.0};
+  summary = SolveMarkerBundleAdjustment({}, &problem);
+  EXPECT_FALSE(summary.success);
+  EXPECT_NE(summary.message.find("position prior 0: sigma <= 0"), std::string::npos)
+      << summary.message;
+}
+
 // Root mean square over the poses of the camera height error (metres) and of the angle
 // between the camera's true and estimated up direction (radians).
 std::pair<double, double> HeightAndTiltRms(const MarkerBundleAdjustmentProblem& estimate,

@@ -53,6 +53,7 @@ BundleAdjustmentSummary SolveBundleAdjustmentWithMarkers(const BundleAdjustmentO
   joint.keypoints = std::move(*problem);
   joint.markers = std::move(factors->markers);
   joint.marker_observations = std::move(factors->observations);
+  joint.position_priors = std::move(factors->position_priors);
   MarkerBundleAdjustmentOptions joint_options;
   joint_options.solver = solver;
   joint_options.marker_huber_delta = options.marker_huber_delta;
@@ -62,6 +63,7 @@ BundleAdjustmentSummary SolveBundleAdjustmentWithMarkers(const BundleAdjustmentO
   *problem = std::move(joint.keypoints);
   factors->markers = std::move(joint.markers);
   factors->observations = std::move(joint.marker_observations);
+  factors->position_priors = std::move(joint.position_priors);
   if (marker_outliers != nullptr) *marker_outliers = joint_summary.marker_outliers;
 
   BundleAdjustmentSummary summary;
@@ -77,6 +79,18 @@ BundleAdjustmentSummary SolveBundleAdjustmentWithMarkers(const BundleAdjustmentO
   summary.num_outliers = joint_summary.num_keypoint_outliers;
   summary.message = joint_summary.message;
   return summary;
+}
+
+std::vector<PositionPrior> PositionPriorsOf(const std::vector<KeyframePosePrior>& priors,
+                                            const std::vector<KeyframeId>& keyframe_ids) {
+  std::vector<PositionPrior> out;
+  for (const KeyframePosePrior& prior : priors) {
+    const auto it = std::find(keyframe_ids.begin(), keyframe_ids.end(), prior.keyframe);
+    if (it == keyframe_ids.end() || !(prior.information(0, 0) > 0.0)) continue;
+    out.push_back({static_cast<std::size_t>(it - keyframe_ids.begin()),
+                   prior.world_from_cam.translation, 1.0 / std::sqrt(prior.information(0, 0))});
+  }
+  return out;
 }
 
 int ApplyMarkerFactors(const MarkerFactors& factors, MarkerLandmarks* landmarks) {

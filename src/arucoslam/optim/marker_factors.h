@@ -8,6 +8,7 @@
 #include "arucoslam/map/map_data.h"
 #include "arucoslam/map/marker_landmark.h"
 #include "arucoslam/optim/bundle_adjustment.h"
+#include "arucoslam/optim/essential_graph.h"
 #include "arucoslam/optim/marker_bundle_adjustment.h"
 #include "arucoslam/optim/pose_graph.h"
 
@@ -44,6 +45,8 @@ struct MarkerFactors {
   std::vector<MarkerBundleAdjustmentProblem::CornerObservation> observations;
   std::vector<MarkerId> marker_ids;  // per entry of `markers`
   int num_fixed_markers = 0;         // fixed markers with at least one observation
+  // Soft priors on camera centres of the problem's poses, solved with the markers.
+  std::vector<PositionPrior> position_priors;
 
   bool empty() const { return observations.empty(); }
 };
@@ -64,6 +67,11 @@ BundleAdjustmentSummary SolveBundleAdjustmentWithMarkers(const BundleAdjustmentO
                                                          MarkerFactors* factors,
                                                          BundleAdjustmentProblem* problem,
                                                          std::vector<bool>* marker_outliers = nullptr);
+
+// The position part of `priors` for the problem poses whose keyframes they name (pose i is
+// keyframe_ids[i]): centre from world_from_cam, sigma from the information's first entry.
+std::vector<PositionPrior> PositionPriorsOf(const std::vector<KeyframePosePrior>& priors,
+                                            const std::vector<KeyframeId>& keyframe_ids);
 
 // Writes the solved poses of non-fixed markers back into `landmarks`; returns how many.
 int ApplyMarkerFactors(const MarkerFactors& factors, MarkerLandmarks* landmarks);

@@ -191,6 +191,26 @@ TEST(MarkerFactorsTest, GlobalBundleAdjustmentWithMarkersFixesNoKeyframe) {
   EXPECT_EQ(fused.map.Read([](const MapData& data) { return data.CheckInvariants(); }), "");
 }
 
+TEST(MarkerFactorsTest, GlobalSnapshotCarriesThePositionPriorsOfItsKeyframes) {
+  MarkerSceneMap scene;
+  Build(scene, ScaleError());
+  KeyframePosePrior prior;
+  prior.keyframe = scene.keyframes[5];
+  prior.world_from_cam = Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(2.0, 0.1, 1.0));
+  prior.information = Matrix6d::Identity() / (0.1 * 0.1);
+  KeyframePosePrior elsewhere = prior;
+  elsewhere.keyframe = KeyframeId(100000);  // no keyframe of this map
+  const GlobalBundleAdjustmentSnapshot snapshot = scene.map.Read([&](const MapData& data) {
+    return TakeGlobalSnapshot(data, {}, &scene.landmarks, {prior, elsewhere});
+  });
+  ASSERT_EQ(snapshot.markers.position_priors.size(), 1u);
+  const PositionPrior& taken = snapshot.markers.position_priors.front();
+  ASSERT_LT(taken.pose_index, snapshot.keyframe_ids.size());
+  EXPECT_EQ(snapshot.keyframe_ids[taken.pose_index], scene.keyframes[5]);
+  EXPECT_EQ(taken.centre_in_world, Eigen::Vector3d(2.0, 0.1, 1.0));
+  EXPECT_NEAR(taken.sigma_m, 0.1, 1e-12);
+}
+
 TEST(MarkerFactorsTest, LocalBundleAdjustmentEstimatesAnUnknownMarker) {
   MarkerSceneMap scene;
   Build(scene, Sim3());

@@ -246,7 +246,8 @@ void PlaceRecognition::RunGlobalBundleAdjustmentOnce() {
     std::unique_lock edit = LockMapEdits();
     epoch = epoch_;
     snapshot = map_.Read([&](const MapData& data) {
-      return TakeGlobalSnapshot(data, options_.global_ba, marker_landmarks_);
+      return TakeGlobalSnapshot(data, options_.global_ba, marker_landmarks_,
+                                bundle_adjustment_priors_);
     });
   }
   if (snapshot.problem.observations.empty()) return;

@@ -100,6 +100,11 @@ class PlaceRecognition {
   // ones fixed, mapped ones estimated). Call it holding LockMapEdits; the landmarks are read
   // and written only under that lock. Null: keypoints only.
   void SetMarkerLandmarks(MarkerLandmarks* landmarks) { marker_landmarks_ = landmarks; }
+  // Camera-centre priors that join global BA (the bridge over a tracking gap). Call it
+  // holding LockMapEdits, like SetMarkerLandmarks.
+  void SetBundleAdjustmentPriors(std::vector<KeyframePosePrior> priors) {
+    bundle_adjustment_priors_ = std::move(priors);
+  }
   // ... and the marker pose priors for the loops' essential graphs (LoopCloser::SetPosePriors;
   // the source is called on the loop-closing thread).
   void SetLoopPosePriors(LoopCloser::PosePriorSource source, const EssentialGraphOptions& graph) {
@@ -139,6 +144,7 @@ class PlaceRecognition {
   LoopDetector detector_;
   LoopCloser closer_;
   MarkerLandmarks* marker_landmarks_ = nullptr;  // guarded by edit_mutex_
+  std::vector<KeyframePosePrior> bundle_adjustment_priors_;  // under LockMapEdits
 
   std::mutex edit_mutex_;
   std::uint64_t epoch_ = 0;  // under edit_mutex_: bumped by every change a global BA cannot merge

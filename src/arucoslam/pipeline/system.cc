@@ -36,7 +36,8 @@ bool SystemOptions::Check() const {
          map_rotation_gates.Check() && refine_min_inlier_fraction > 0.0 &&
          refine_min_inlier_fraction <= 1.0 && bridge_motion.Check() &&
          bridge_position_sigma_m > 0.0 && bridge_position_sigma_per_s >= 0.0 &&
-         bridge_rotation_sigma_rad > 0.0 && bridge_rotation_sigma_per_s >= 0.0;
+         bridge_max_acceleration_m_s2 >= 0.0 && bridge_rotation_sigma_rad > 0.0 &&
+         bridge_rotation_sigma_per_s >= 0.0;
 }
 
 System::System(const CameraModel& camera, const SystemOptions& options)
@@ -466,6 +467,7 @@ void System::ResetMap() {
   mapper_ = std::make_unique<LocalMapper>(*map_, options_.mapper);
   GuardMarkerKeyframes();
   MakePlaceRecognition();
+  HoldBridgePriors({});  // the new places hold none yet; the marker mapper drops them
   const int marker_generation = ResetMarkerMapping();
   if (kept_for_merge) closed_map_->marker_generation = marker_generation;
   poses_ = std::move(kept);
@@ -484,6 +486,7 @@ void System::ResetMap() {
   rotation_vote_.Clear();
   absorbed_keyframes_.clear();
   bridge_priors_.clear();
+  bridge_adjustment_priors_.clear();
   lost_with_markers_ = 0;
   lost_since_s_.reset();
   ForgetMarkerAgreement();

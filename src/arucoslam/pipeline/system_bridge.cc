@@ -36,10 +36,17 @@ void System::AddBridgePrior(KeyframeId keyframe, double timestamp_s) {
   prior.information.bottomRightCorner<3, 3>().diagonal().setConstant(
       1.0 / (rotation_sigma * rotation_sigma));
   bridge_priors_.push_back(prior);
+  // For the bundle adjustments: how far a vehicle accelerating at most at the bound can
+  // stray from the constant-velocity prediction over the gap.
+  const double adjustment_sigma = options_.bridge_position_sigma_m +
+                                  0.5 * options_.bridge_max_acceleration_m_s2 * gap_s * gap_s;
+  prior.information.topLeftCorner<3, 3>().diagonal().setConstant(
+      1.0 / (adjustment_sigma * adjustment_sigma));
+  bridge_adjustment_priors_.push_back(prior);
   ARUCOSLAM_LOG_DEBUG(
       "keyframe {}: bridged over {:.2f} s from the closed map (sigma {:.2f} m, "
-      "{:.2f} rad)",
-      keyframe.value, gap_s, position_sigma, rotation_sigma);
+      "{:.2f} rad; {:.2f} m in bundle adjustment)",
+      keyframe.value, gap_s, position_sigma, rotation_sigma, adjustment_sigma);
 }
 
 bool System::CorrectAcrossBridge() {
@@ -47,6 +54,8 @@ bool System::CorrectAcrossBridge() {
   std::vector<KeyframePosePrior> priors = KnownMarkerPriors();
   priors.insert(priors.end(), bridge_priors_.begin(), bridge_priors_.end());
   bridge_priors_.clear();
+  std::vector<KeyframePosePrior> adjustment_priors = std::move(bridge_adjustment_priors_);
+  bridge_adjustment_priors_.clear();
   if (places_) places_->MapMovedExternally();
   // The absorbed map is in the world already (adjusted with its markers when it was
   // closed): only the new map bends, between the bridge at its start and its markers.
@@ -58,10 +67,21 @@ bool System::CorrectAcrossBridge() {
       result.num_keyframes, result.num_priors, absorbed_keyframes_.size(),
       result.summary.BriefReport());
   if (!result.applied) return false;
+  if (options_.bridge_in_bundle_adjustment) {
+    adjustment_priors.insert(adjustment_priors.begin(), held_bridge_priors_.begin(),
+                             held_bridge_priors_.end());
+    HoldBridgePriors(std::move(adjustment_priors));
+  }
   if (places_) places_->RecordScaleChanges(result.scale_changes);
   std::lock_guard lock(stats_mutex_);
   ++stats_.num_bridged_gaps;
   return true;
+}
+
+void System::HoldBridgePriors(std::vector<KeyframePosePrior> priors) {
+  held_bridge_priors_ = std::move(priors);
+  if (marker_mapper_) marker_mapper_->SetPositionPriors(held_bridge_priors_);
+  if (places_) places_->SetBundleAdjustmentPriors(held_bridge_priors_);
 }
 
 }  // namespace arucoslam

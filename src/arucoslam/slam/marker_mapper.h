@@ -14,6 +14,7 @@
 #include "arucoslam/map/marker_landmark.h"
 #include "arucoslam/markers/marker_map.h"
 #include "arucoslam/markers/marker_pose.h"
+#include "arucoslam/optim/essential_graph.h"
 #include "arucoslam/optim/marker_bundle_adjustment.h"
 
 namespace arucoslam {
@@ -97,6 +98,11 @@ class MarkerMapper {
   // known markers fixed, mapped ones estimated. Poses, points and marker poses are written
   // back on success (the keyframe poses this mapper keeps too). One camera for all.
   MarkerBundleAdjustmentSummary Refine(MapData* map);
+  // Camera-centre priors on keyframes that Refine adds (the bridge over a tracking gap);
+  // those naming no keyframe of the map are skipped.
+  void SetPositionPriors(std::vector<KeyframePosePrior> priors) {
+    position_priors_ = std::move(priors);
+  }
   // Refines only the mapped markers against the recorded keyframe poses, live and retired
   // (held fixed).
   MarkerBundleAdjustmentSummary RefineMarkers();
@@ -154,6 +160,7 @@ class MarkerMapper {
   std::string dictionary_;
   double unknown_size_ = 0.0;
   MarkerLandmarks landmarks_;
+  std::vector<KeyframePosePrior> position_priors_;
   std::map<int, Record> records_;         // every keyframe recorded, live or retired
   std::map<KeyframeId, int> live_;         // live keyframe -> its record
   int next_record_ = 0;

@@ -5,6 +5,7 @@
 #include <optional>
 #include <utility>
 
+#include "arucoslam/optim/marker_factors.h"
 #include "arucoslam/slam/marker_mapper.h"
 
 namespace arucoslam {
@@ -132,6 +133,7 @@ MarkerBundleAdjustmentSummary MarkerMapper::Refine(MapData* map) {
   ProblemIndex index;
   MarkerBundleAdjustmentProblem problem = BuildProblem(map, &index);
   problem.ground_plane_prior = options_.ground_plane_prior;
+  problem.position_priors = PositionPriorsOf(position_priors_, index.keyframes);
   MarkerBundleAdjustmentSummary summary =
       SolveMarkerBundleAdjustment(options_.bundle_adjustment, &problem);
   if (!summary.success) return summary;
