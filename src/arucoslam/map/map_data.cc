@@ -71,6 +71,16 @@ bool MapData::Absorb(const MapData& other, KeyframeId attach_to, AbsorbedIds* id
     for (const auto& [keyframe, index] : source.observations) {
       AddObservation(ids->keyframes.at(keyframe), index, id);
     }
+    // The reference is an id of `other`: the same number may name a keyframe of this map,
+    // whose corrections the point would then follow.
+    MapPoint& point = points_.at(id);
+    const auto reference = ids->keyframes.find(source.reference_keyframe);
+    if (reference != ids->keyframes.end()) {
+      point.reference_keyframe = reference->second;
+    } else {
+      point.reference_keyframe =
+          point.observations.empty() ? KeyframeId() : point.observations.begin()->first;
+    }
   }
   for (const auto& [old_id, id] : ids->keyframes) {
     const KeyframeId old_parent = other.graph_.Parent(old_id);

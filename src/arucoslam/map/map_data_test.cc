@@ -66,6 +66,30 @@ TEST(MapDataTest, ObservationsAndCovisibilityAreConsistent) {
   EXPECT_EQ(f.data.LastKeyframe(), f.keyframes[2]);
 }
 
+TEST(MapDataTest, AbsorbedPointsKeepTheirReferenceKeyframeUnderItsNewId) {
+  // Both maps number their keyframes from the same start: the other map's reference ids
+  // also name keyframes of the host, which a pose-graph correction would move the points by.
+  Fixture host;
+  MapData other;
+  std::vector<KeyframeId> other_keyframes;
+  for (int k = 0; k < 3; ++k) {
+    other_keyframes.push_back(other.AddKeyframe(MakeKeyframe(20, Eigen::Vector3d(k, 0, 0), k)));
+  }
+  MapPoint created;
+  created.p_in_world = Eigen::Vector3d(1, 1, 5);
+  created.reference_keyframe = other_keyframes[2];
+  const MapPointId point = other.AddMapPoint(created);
+  ASSERT_TRUE(other.AddObservation(other_keyframes[1], 4, point));
+  ASSERT_TRUE(other.AddObservation(other_keyframes[2], 4, point));
+  ASSERT_EQ(other.CheckInvariants(), "");
+  ASSERT_NE(std::count(host.keyframes.begin(), host.keyframes.end(), other_keyframes[2]), 0);
+  AbsorbedIds ids;
+  ASSERT_TRUE(host.data.Absorb(other, host.keyframes[1], &ids));
+  EXPECT_EQ(host.data.CheckInvariants(), "");
+  EXPECT_EQ(host.data.FindMapPoint(ids.points.at(point))->reference_keyframe,
+            ids.keyframes.at(other_keyframes[2]));
+}
+
 TEST(MapDataTest, AbsorbAddsAnotherMapUnderNewIds) {
   Fixture host;
   Fixture other;
