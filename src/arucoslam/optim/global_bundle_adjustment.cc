@@ -75,11 +75,11 @@ GlobalBundleAdjustmentSnapshot TakeGlobalSnapshot(const MapData& data,
   if (landmarks != nullptr) {
     snapshot.markers =
         CollectMarkerFactors(data, snapshot.keyframe_ids, *landmarks, options.markers);
-    snapshot.markers.position_priors = PositionPriorsOf(priors, snapshot.keyframe_ids);
     if (snapshot.markers.num_fixed_markers > 0) {
       for (auto& pose : snapshot.problem.poses) pose.fixed = false;
     }
   }
+  snapshot.markers.position_priors = PositionPriorsOf(priors, snapshot.keyframe_ids);
   return snapshot;
 }
 

@@ -50,7 +50,7 @@ struct GlobalBundleAdjustmentResult {
 };
 
 // With `landmarks`, every keyframe's views of them join the problem (read the landmarks
-// while nothing edits them), and so do the centres of `priors` (PositionPriorsOf).
+// while nothing edits them); the centres of `priors` join it either way (PositionPriorsOf).
 GlobalBundleAdjustmentSnapshot TakeGlobalSnapshot(
     const MapData& data, const GlobalBundleAdjustmentOptions& options,
     const MarkerLandmarks* landmarks = nullptr, const std::vector<KeyframePosePrior>& priors = {});

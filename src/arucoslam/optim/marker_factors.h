@@ -45,10 +45,11 @@ struct MarkerFactors {
   std::vector<MarkerBundleAdjustmentProblem::CornerObservation> observations;
   std::vector<MarkerId> marker_ids;  // per entry of `markers`
   int num_fixed_markers = 0;         // fixed markers with at least one observation
-  // Soft priors on camera centres of the problem's poses, solved with the markers.
+  // Soft priors on camera centres of the problem's poses, solved with the markers (or
+  // alone: a problem with priors and no marker is still a joint solve).
   std::vector<PositionPrior> position_priors;
 
-  bool empty() const { return observations.empty(); }
+  bool empty() const { return observations.empty() && position_priors.empty(); }
 };
 
 // Every landmark seen by a keyframe of `keyframe_ids` (problem pose i is keyframe_ids[i]),

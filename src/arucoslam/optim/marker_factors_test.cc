@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <set>
 
@@ -209,6 +210,38 @@ TEST(MarkerFactorsTest, GlobalSnapshotCarriesThePositionPriorsOfItsKeyframes) {
   EXPECT_EQ(snapshot.keyframe_ids[taken.pose_index], scene.keyframes[5]);
   EXPECT_EQ(taken.centre_in_world, Eigen::Vector3d(2.0, 0.1, 1.0));
   EXPECT_NEAR(taken.sigma_m, 0.1, 1e-12);
+}
+
+TEST(MarkerFactorsTest, PositionPriorsJoinAGlobalSolveWithoutMarkers) {
+  // Keypoints only, the map 5% too large: the last keyframe ends far from its true centre
+  // unless a prior there takes part in the solve.
+  const auto last_centre_error = [](const std::vector<KeyframePosePrior>& priors) {
+    MarkerSceneMap scene;
+    Build(scene, ScaleError());
+    GlobalBundleAdjustmentOptions options;
+    options.solver.max_iterations = 30;
+    GlobalBundleAdjustmentSnapshot snapshot = scene.map.Read(
+        [&](const MapData& data) { return TakeGlobalSnapshot(data, options, nullptr, priors); });
+    EXPECT_EQ(snapshot.markers.position_priors.size(), priors.size());
+    EXPECT_TRUE(SolveGlobalSnapshot(options, &snapshot).success);
+    const std::size_t last = snapshot.keyframe_ids.size() - 1;
+    return (snapshot.problem.poses[last].cam_from_world.Inverse().translation -
+            scene.truth.keypoints.poses[last].cam_from_world.Inverse().translation)
+        .norm();
+  };
+  MarkerSceneMap reference;
+  Build(reference, ScaleError());
+  KeyframePosePrior prior;
+  prior.keyframe = reference.keyframes.back();
+  prior.world_from_cam = reference.truth.keypoints.poses.back().cam_from_world.Inverse();
+  prior.information = Matrix6d::Identity() / (0.01 * 0.01);
+  const double without = last_centre_error({});
+  const double with = last_centre_error({prior});
+  std::printf("last keyframe centre error: %.4f m without the prior, %.4f m with it\n", without,
+              with);
+  // Measured: 0.30 m without, 9 mm with it.
+  EXPECT_GT(without, 0.2);
+  EXPECT_LT(with, 0.03);
 }
 
 TEST(MarkerFactorsTest, LocalBundleAdjustmentEstimatesAnUnknownMarker) {
