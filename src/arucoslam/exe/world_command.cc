@@ -92,6 +92,11 @@ void AddWorldCommand(CLI::App& app, int& exit_status) {
                     "one more marker board on the corridor's long wall at each end (the wall "
                     "the route faces while it turns there)");
   factory
+      ->add_option("--wall-markers", args->options.wall_marker_spacing_m,
+                   "marker boards along the corridor's long wall every this many metres, 1-20 "
+                   "(0: none; the ArucoSLAM authors' simulation has one every metre)")
+      ->capture_default_str();
+  factory
       ->add_option("--camera-height", args->options.camera_height_m,
                    "height of the route's camera and of the marker centres, metres")
       ->capture_default_str();

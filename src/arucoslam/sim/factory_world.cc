@@ -122,6 +122,9 @@ class FactoryBuilder {
   void AddMachine(const std::string& name, const Rigid3& pose, double length, double depth,
                   SeededRandom& random);
   void AddDocks();
+  // Where the corridor's wall boards go (corridor_end_markers, wall_marker_spacing_m):
+  // x along the y = 0 wall, ascending.
+  std::vector<double> CorridorWallBoards() const;
   void AddDock(const std::string& name, double x_wall, double y, bool faces_plus_x, int first_id);
   // A board at camera height against a wall (`world_from_board`: +x out of the wall) carrying
   // markers_per_dock markers from `first_id`; their ids, or none without markers.
@@ -414,13 +417,14 @@ void FactoryBuilder::AddDocks() {
   const int per_dock = options_.markers_per_dock;
   std::vector<double> lanes = {kCorridor / 2};
   for (int a = 0; a < options_.aisles; ++a) lanes.push_back(AisleCentre(a));
+  const std::vector<double> wall_boards = CorridorWallBoards();
   const int needed =
-      (static_cast<int>(lanes.size()) * 2 + (options_.corridor_end_markers ? 2 : 0)) * per_dock;
+      (static_cast<int>(lanes.size()) * 2 + static_cast<int>(wall_boards.size())) * per_dock;
   const int available = DictionaryFromName(options_.dictionary, "--dictionary")->bytesList.rows;
   if (options_.markers && needed > available) {
-    throw InputError("--markers-per-dock", std::to_string(needed) + " markers are needed but " +
-                                               options_.dictionary + " has only " +
-                                               std::to_string(available) + " ids");
+    throw InputError(wall_boards.size() > 2 ? "--wall-markers" : "--markers-per-dock",
+                     std::to_string(needed) + " markers are needed but " + options_.dictionary +
+                         " has only " + std::to_string(available) + " ids");
   }
   int next_id = 0;
   for (std::size_t lane = 0; lane < lanes.size(); ++lane) {
@@ -430,14 +434,42 @@ void FactoryBuilder::AddDocks() {
     AddDock("dock_" + lane_name + "_east", Length(), lanes[lane], false, next_id);
     next_id += per_dock;
   }
-  if (!options_.corridor_end_markers || !options_.markers) return;
-  for (const double x : {1.8, Length() - 1.8}) {
+  if (!options_.markers) return;
+  int board = 0;
+  for (const double x : wall_boards) {
     const Rigid3 world_from_board = Pose(x, 0.0, 0.0, kPi / 2);  // facing +y
-    FactoryModel& model =
-        NewModel(x < Length() / 2 ? "sign_corridor_west" : "sign_corridor_east", world_from_board);
-    AddMarkerBoard(model, world_from_board, next_id);
+    const bool end = std::abs(x - 1.8) < 1e-9 || std::abs(x - (Length() - 1.8)) < 1e-9;
+    const std::string name = end && options_.corridor_end_markers
+                                 ? (x < Length() / 2 ? "sign_corridor_west" : "sign_corridor_east")
+                                 : "sign_corridor_" + std::to_string(board);
+    AddMarkerBoard(NewModel(name, world_from_board), world_from_board, next_id);
     next_id += per_dock;
+    ++board;
   }
+}
+
+std::vector<double> FactoryBuilder::CorridorWallBoards() const {
+  const double first = 1.8, last = Length() - 1.8;
+  std::vector<double> xs;
+  if (options_.corridor_end_markers) xs = {first, last};
+  const double spacing = options_.wall_marker_spacing_m;
+  if (spacing > 0.0) {
+    // The pillars' x (AddShell); a board's half width plus the pillar guard's keeps clear.
+    const int pillars = std::max(2, static_cast<int>(std::round(Length() / 8.0)));
+    const double clearance = MarkerBoardWidth() / 2 + 0.22 + 0.05;
+    for (double x = first; x <= last + 1e-9; x += spacing) {
+      bool clear = true;
+      for (int i = 1; i < pillars; ++i) {
+        if (std::abs(x - Length() * i / pillars) < clearance) clear = false;
+      }
+      for (const double taken : xs) {
+        if (std::abs(x - taken) < 1e-6) clear = false;
+      }
+      if (clear) xs.push_back(x);
+    }
+  }
+  std::sort(xs.begin(), xs.end());
+  return xs;
 }
 
 std::vector<int> FactoryBuilder::AddMarkerBoard(FactoryModel& model, const Rigid3& world_from_board,
@@ -641,7 +673,9 @@ bool FactoryOptions::Check() const {
   return aisles >= 1 && aisles <= 8 && aisle_length_m >= 6.0 && aisle_length_m <= 60.0 &&
          marker_size_m > 0.05 && marker_size_m <= 1.0 && markers_per_dock >= 1 &&
          markers_per_dock <= 4 && marker_image_px >= 16 && marker_image_px <= 2048 &&
-         camera_height_m >= 0.3 && camera_height_m <= 1.0;
+         camera_height_m >= 0.3 && camera_height_m <= 1.0 &&
+         (wall_marker_spacing_m == 0.0 ||
+          (wall_marker_spacing_m >= 1.0 && wall_marker_spacing_m <= 20.0));
 }
 
 TextureLevel TextureLevelFromName(const std::string& name) {
@@ -665,9 +699,10 @@ std::string TextureLevelName(TextureLevel level) {
 
 FactoryWorld BuildFactoryWorld(const FactoryOptions& options) {
   if (!options.Check()) {
-    throw InputError("world factory",
-                     "options out of range (aisles 1-8, aisle length 6-60 m, marker size 0.05-1 m, "
-                     "1-4 markers per dock, camera height 0.3-1 m)");
+    throw InputError(
+        "world factory",
+        "options out of range (aisles 1-8, aisle length 6-60 m, marker size 0.05-1 m, "
+        "1-4 markers per dock, camera height 0.3-1 m, wall markers 0 or every 1-20 m)");
   }
   DictionaryFromName(options.dictionary, "--dictionary");
   return FactoryBuilder(options).Build();

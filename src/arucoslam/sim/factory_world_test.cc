@@ -217,6 +217,60 @@ TEST_F(FactoryWorldTest, CorridorEndMarkersFaceTheRouteInItsTurn) {
   EXPECT_GE(DistanceDrivenFacing(poses, east.world_from_marker.translation, 35.0, 4.0), 0.3);
 }
 
+// Wall boards every 3 m along the corridor's y = 0 wall: facing +y at camera height, at
+// least 3 m apart, clear of the pillars, ids after the docks' (dock markers unchanged); the
+// corridor-end flag adds no second board at the ends; too many boards for the dictionary
+// and a spacing out of range are refused.
+TEST_F(FactoryWorldTest, WallMarkersLineTheCorridorClearOfThePillars) {
+  const FactoryWorld plain = BuildFactoryWorld(FactoryOptions{});
+  FactoryOptions options;
+  options.wall_marker_spacing_m = 3.0;
+  const FactoryWorld world = BuildFactoryWorld(options);
+  const int docks = static_cast<int>(plain.markers.markers.size());
+  const int boards = static_cast<int>(world.markers.markers.size()) - docks;
+  const double length = world.hall_length_m;
+  // (length - 3.6) / 3 + 1 positions, minus those on a pillar.
+  EXPECT_GE(boards, static_cast<int>((length - 3.6) / 3.0) - 2);
+  EXPECT_LE(boards, static_cast<int>((length - 3.6) / 3.0) + 1);
+  const int pillars = std::max(2, static_cast<int>(std::round(length / 8.0)));
+  double previous_x = -1e9;
+  for (int id = docks; id < docks + boards; ++id) {
+    const MarkerInfo& marker = world.markers.markers.at(id);
+    const Eigen::Vector3d& centre = marker.world_from_marker.translation;
+    EXPECT_NEAR((marker.world_from_marker.rotation * Eigen::Vector3d::UnitZ()).y(), 1.0, 1e-12);
+    EXPECT_NEAR(centre.y(), 0.022, 1e-12);
+    EXPECT_NEAR(centre.z(), options.camera_height_m, 1e-12);
+    EXPECT_GE(centre.x(), 1.8 - 1e-9);
+    EXPECT_LE(centre.x(), length - 1.8 + 1e-9);
+    EXPECT_GE(centre.x() - previous_x, 3.0 - 1e-9);
+    previous_x = centre.x();
+    for (int i = 1; i < pillars; ++i) EXPECT_GT(std::abs(centre.x() - length * i / pillars), 0.5);
+  }
+  for (const auto& [id, marker] : plain.markers.markers) {
+    EXPECT_LT((world.markers.markers.at(id).world_from_marker.translation -
+               marker.world_from_marker.translation)
+                  .norm(),
+              1e-12);
+  }
+  // With the corridor-end boards too: one board at each end, none doubled.
+  options.corridor_end_markers = true;
+  const FactoryWorld both = BuildFactoryWorld(options);
+  std::vector<double> xs;
+  for (int id = docks; id < static_cast<int>(both.markers.markers.size()); ++id) {
+    xs.push_back(both.markers.markers.at(id).world_from_marker.translation.x());
+  }
+  ASSERT_GE(xs.size(), static_cast<std::size_t>(boards));
+  EXPECT_NEAR(xs.front(), 1.8, 1e-9);
+  EXPECT_NEAR(xs.back(), length - 1.8, 1e-9);
+  for (std::size_t i = 1; i < xs.size(); ++i) EXPECT_GT(xs[i] - xs[i - 1], 0.5);
+  options.wall_marker_spacing_m = 1.0;
+  options.markers_per_dock = 3;  // 24 dock markers and 3 per board: more than 50 ids
+  EXPECT_THROW(BuildFactoryWorld(options), InputError);
+  options.markers_per_dock = 1;
+  options.wall_marker_spacing_m = 0.5;
+  EXPECT_THROW(BuildFactoryWorld(options), InputError);
+}
+
 TEST_F(FactoryWorldTest, SdformatParsesTheWorldAndMarkerPosesMatchTheJson) {
   FactoryOptions options;
   options.aisles = 2;
