@@ -47,11 +47,16 @@ void RunFactory(FactoryArgs args) {
   out.Commit();
   std::size_t visuals = 0;
   for (const FactoryModel& model : world.models) visuals += model.visuals.size();
+  std::size_t dock_markers = 0;
+  for (const FactoryDock& dock : world.docks) dock_markers += dock.marker_ids.size();
+  const std::size_t wall_markers = world.markers.markers.size() - dock_markers;
+  const std::string wall =
+      wall_markers > 0 ? " and " + std::to_string(wall_markers) + " on the corridor wall" : "";
   std::printf(
       "wrote %s: hall %.1f x %.1f m, %zu models (%zu visuals), %zu textures, %zu markers at "
-      "%zu docks; path.json: %.1f m, %.1f s\n",
+      "%zu docks%s; path.json: %.1f m, %.1f s\n",
       args.out.c_str(), world.hall_length_m, world.hall_width_m, world.models.size(), visuals,
-      world.textures.size(), world.markers.markers.size(), world.docks.size(), RouteLength(route),
+      world.textures.size(), dock_markers, world.docks.size(), wall.c_str(), RouteLength(route),
       RouteDuration(route));
 }
 

@@ -62,12 +62,27 @@ TEST_F(WorldCommandTest, MarkersOffWritesAnEmptyMap) {
   EXPECT_FALSE(fs::exists(out / "markers" / "0.png"));
 }
 
+TEST_F(WorldCommandTest, WallMarkersAreCountedApartFromTheDocks) {
+  const fs::path out = dir_ / "wall";
+  const auto result = RunArucoslam(
+      "world factory --seed 1 --aisles 1 --aisle-length 8 --wall-markers 3 --out " + out.string());
+  ASSERT_EQ(result.status, 0) << result.output;
+  EXPECT_NE(result.output.find("4 markers at 4 docks and "), std::string::npos) << result.output;
+  const MarkerMap markers = ReadMarkerMapJson(out / "markers.json");
+  EXPECT_GT(markers.markers.size(), 4u);
+  EXPECT_NE(
+      result.output.find(std::to_string(markers.markers.size() - 4) + " on the corridor wall"),
+      std::string::npos)
+      << result.output;
+}
+
 TEST_F(WorldCommandTest, BadInputIsOneLineAndWritesNothing) {
   const fs::path out = dir_ / "never";
   for (const std::string& arguments :
        {std::string("--texture shiny"), std::string("--markers maybe"), std::string("--aisles 0"),
         std::string("--aisle-length 100"), std::string("--dictionary DICT_9X9_1"),
-        std::string("--aisles 8 --markers-per-dock 4"), std::string("--camera-height 1.5")}) {
+        std::string("--aisles 8 --markers-per-dock 4"), std::string("--camera-height 1.5"),
+        std::string("--wall-markers 0.5"), std::string("--wall-markers 1 --markers-per-dock 3")}) {
     const auto result =
         RunArucoslam("world factory --seed 1 " + arguments + " --out " + out.string());
     EXPECT_EQ(result.status, 2) << arguments << ": " << result.output;
