@@ -31,6 +31,9 @@ constexpr double kRackHeight = 4.0;
 constexpr double kHallHeight = 6.0;
 constexpr double kWallThickness = 0.3;
 constexpr double kBoardThickness = 0.02;  // dock board on the wall
+constexpr double kPillarGuardWidth = 0.44;  // the striped guard at a pillar's foot
+// The corridor-end boards' distance from the end walls (the first and last wall board).
+constexpr double kCorridorEndBoardInset = 1.8;
 constexpr double kUTurnRadius = 0.9;      // the default route's tight turn
 constexpr double kEndApproach = 1.75;     // route waypoints this far from the end walls
 
@@ -99,6 +102,13 @@ class FactoryBuilder {
     return kCorridor + kPartition + aisle * (kAisle + 2 * kRackDepth + kRackGap);
   }
   double AisleCentre(int aisle) const { return AisleStart(aisle) + kAisle / 2; }
+  // x of the pillars along both long walls, about 8 m apart.
+  std::vector<double> PillarXs() const {
+    const int count = std::max(2, static_cast<int>(std::round(Length() / 8.0)));
+    std::vector<double> xs;
+    for (int i = 1; i < count; ++i) xs.push_back(Length() * i / count);
+    return xs;
+  }
   std::uint64_t Stream(std::uint64_t part) const {
     return (static_cast<std::uint64_t>(options_.seed) << 24) ^ (part * 0x9E3779B97F4A7C15ull);
   }
@@ -206,14 +216,14 @@ void FactoryBuilder::AddShell() {
   }
   // Pillars every ~8 m along the long walls, with a striped guard at the bottom.
   FactoryModel& pillars = NewModel("pillars", Rigid3());
-  const int count = std::max(2, static_cast<int>(std::round(length / 8.0)));
-  for (int i = 1; i < count; ++i) {
-    const double x = length * i / count;
+  const std::vector<double> pillar_xs = PillarXs();
+  for (std::size_t i = 1; i <= pillar_xs.size(); ++i) {
+    const double x = pillar_xs[i - 1];
     for (const double y : {0.15, width - 0.15}) {
       const std::string name = "pillar_" + std::to_string(i) + (y < 1 ? "_s" : "_n");
       pillars.visuals.push_back(Box(name, Pose(x, y, h / 2), {0.4, 0.3, h}, {0.62, 0.63, 0.64}));
       pillars.visuals.push_back(
-          Box(name + "_guard", Pose(x, y, 0.5), {0.44, 0.34, 1.0}, kWhite, "hazard"));
+          Box(name + "_guard", Pose(x, y, 0.5), {kPillarGuardWidth, 0.34, 1.0}, kWhite, "hazard"));
     }
   }
   FactoryModel& ceiling = NewModel("ceiling", Rigid3());
@@ -422,7 +432,7 @@ void FactoryBuilder::AddDocks() {
       (static_cast<int>(lanes.size()) * 2 + static_cast<int>(wall_boards.size())) * per_dock;
   const int available = DictionaryFromName(options_.dictionary, "--dictionary")->bytesList.rows;
   if (options_.markers && needed > available) {
-    throw InputError(wall_boards.size() > 2 ? "--wall-markers" : "--markers-per-dock",
+    throw InputError(options_.wall_marker_spacing_m > 0.0 ? "--wall-markers" : "--markers-per-dock",
                      std::to_string(needed) + " markers are needed but " + options_.dictionary +
                          " has only " + std::to_string(available) + " ids");
   }
@@ -438,7 +448,8 @@ void FactoryBuilder::AddDocks() {
   int board = 0;
   for (const double x : wall_boards) {
     const Rigid3 world_from_board = Pose(x, 0.0, 0.0, kPi / 2);  // facing +y
-    const bool end = std::abs(x - 1.8) < 1e-9 || std::abs(x - (Length() - 1.8)) < 1e-9;
+    const bool end = std::abs(x - kCorridorEndBoardInset) < 1e-9 ||
+                     std::abs(x - (Length() - kCorridorEndBoardInset)) < 1e-9;
     const std::string name = end && options_.corridor_end_markers
                                  ? (x < Length() / 2 ? "sign_corridor_west" : "sign_corridor_east")
                                  : "sign_corridor_" + std::to_string(board);
@@ -449,18 +460,18 @@ void FactoryBuilder::AddDocks() {
 }
 
 std::vector<double> FactoryBuilder::CorridorWallBoards() const {
-  const double first = 1.8, last = Length() - 1.8;
+  const double first = kCorridorEndBoardInset, last = Length() - kCorridorEndBoardInset;
   std::vector<double> xs;
   if (options_.corridor_end_markers) xs = {first, last};
   const double spacing = options_.wall_marker_spacing_m;
   if (spacing > 0.0) {
-    // The pillars' x (AddShell); a board's half width plus the pillar guard's keeps clear.
-    const int pillars = std::max(2, static_cast<int>(std::round(Length() / 8.0)));
-    const double clearance = MarkerBoardWidth() / 2 + 0.22 + 0.05;
+    // A board's half width plus the pillar guard's, and 5 cm, keeps clear of a pillar.
+    const std::vector<double> pillar_xs = PillarXs();
+    const double clearance = MarkerBoardWidth() / 2 + kPillarGuardWidth / 2 + 0.05;
     for (double x = first; x <= last + 1e-9; x += spacing) {
       bool clear = true;
-      for (int i = 1; i < pillars; ++i) {
-        if (std::abs(x - Length() * i / pillars) < clearance) clear = false;
+      for (const double pillar_x : pillar_xs) {
+        if (std::abs(x - pillar_x) < clearance) clear = false;
       }
       for (const double taken : xs) {
         if (std::abs(x - taken) < 1e-6) clear = false;
