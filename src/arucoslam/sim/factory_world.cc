@@ -585,13 +585,14 @@ void FactoryBuilder::AddPosters() {
                     : options_.texture == TextureLevel::kMedium ? 6
                                                                 : 10;
   FactoryModel& model = NewModel("posters", Rigid3());
+  const std::vector<double> pillar_xs = PillarXs();
   int placed = 0;
   for (int attempt = 0; attempt < 200 && placed < count; ++attempt) {
     const int wall = random.Int(0, 3);  // south, north, west, east
     const bool long_wall = wall < 2;
     const double along = random.Uniform(1.0, (long_wall ? Length() : Width()) - 1.0);
-    if (long_wall && std::abs(std::remainder(
-                         along, Length() / std::max(2.0, std::round(Length() / 8.0)))) < 0.7) {
+    if (long_wall && std::any_of(pillar_xs.begin(), pillar_xs.end(),
+                                 [along](double x) { return std::abs(along - x) < 0.7; })) {
       continue;  // a pillar
     }
     bool near_dock = false;
