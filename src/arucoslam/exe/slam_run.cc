@@ -45,6 +45,7 @@ SlamRunStats MakeStats(const std::string& dataset_label, const Dataset& dataset,
   out.keyframes = static_cast<int>(system.map().NumKeyframes());
   out.map_points = static_cast<int>(system.map().NumMapPoints());
   out.refined_frame_poses = stats.num_refined_frame_poses;
+  out.yielded_bundle_adjustments = stats.num_yielded_bundle_adjustments;
   out.marker_fix_frames = stats.num_marker_frames;
   out.marker_disambiguations = stats.num_marker_disambiguations;
   out.map_rotation_disambiguations = stats.num_map_rotation_disambiguations;

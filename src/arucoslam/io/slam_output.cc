@@ -44,7 +44,8 @@ std::string FormatSlamStatsJson(const SlamRunStats& stats) {
                  {"points", stats.map_points},
                  {"loops_closed", stats.loops_closed},
                  {"global_bundle_adjustments", stats.global_bundle_adjustments},
-                 {"refined_frame_poses", stats.refined_frame_poses}};
+                 {"refined_frame_poses", stats.refined_frame_poses},
+                 {"yielded_bundle_adjustments", stats.yielded_bundle_adjustments}};
   if (stats.markers) {
     json["marker_locations"] = {{"frames_with_fix", stats.marker_fix_frames},
                                 {"disambiguated_by_motion", stats.marker_disambiguations},

@@ -36,6 +36,7 @@ struct SlamRunStats {
   int keyframes = 0;   // in the final map
   int map_points = 0;  // in the final map
   int refined_frame_poses = 0;  // frames re-optimised against the final map
+  int yielded_bundle_adjustments = 0;  // threaded: local BAs ended early for a waiting keyframe
   // With a marker map: frames with a usable marker location, of which one ambiguous
   // marker settled by the motion prediction, and frames whose pose came from markers alone.
   int marker_fix_frames = 0;
@@ -62,7 +63,8 @@ struct SlamRunStats {
 std::string FormatPlyPoints(const std::vector<Eigen::Vector3d>& points);
 // stats.json text: {"format": "arucoslam.stats/1", "dataset", "frames": {..., "left_out"},
 // "tracking": {"losses", "relocalisations", ...}, "map": {..., "loops_closed",
-// "global_bundle_adjustments", "refined_frame_poses"}, with markers "marker_locations":
+// "global_bundle_adjustments", "refined_frame_poses", "yielded_bundle_adjustments"}, with markers
+// "marker_locations":
 // {"frames_with_fix", "disambiguated_by_motion", "disambiguated_by_map_rotation",
 // "marker_only_poses"}, "marker_fusion": {"world_alignments", "drift_corrections",
 // "whole_map_adjustments", "map_merges", "rejected_keypoint_poses", "drift_beyond_gate"},

@@ -45,6 +45,7 @@ TEST(SlamOutput, WritesFourFilesThatReadBack) {
   stats.marker_rejections = 4;
   stats.drift_beyond_gate = 6;
   stats.refined_frame_poses = 17;
+  stats.yielded_bundle_adjustments = 9;
   stats.inconsistent_poses = 5;
   stats.map_rotation_disambiguations = 3;
   TimingSummary summary;
@@ -67,6 +68,7 @@ TEST(SlamOutput, WritesFourFilesThatReadBack) {
   EXPECT_NE(json.find("\"rejected_keypoint_poses\": 4"), std::string::npos);
   EXPECT_NE(json.find("\"drift_beyond_gate\": 6"), std::string::npos);
   EXPECT_NE(json.find("\"refined_frame_poses\": 17"), std::string::npos);
+  EXPECT_NE(json.find("\"yielded_bundle_adjustments\": 9"), std::string::npos);
   EXPECT_NE(json.find("\"left_out\": 5"), std::string::npos);
   EXPECT_NE(json.find("\"disambiguated_by_map_rotation\": 3"), std::string::npos);
   EXPECT_NE(ReadTextFile(dir / "map.ply").find("element vertex 1"), std::string::npos);

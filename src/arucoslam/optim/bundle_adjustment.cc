@@ -8,7 +8,7 @@ namespace arucoslam {
 
 bool BundleAdjustmentOptions::Check() const {
   return max_iterations >= 1 && huber_delta_px > 0.0 && chi_square_threshold > 0.0 &&
-         num_threads >= 1 && function_tolerance > 0.0;
+         num_threads >= 1 && function_tolerance > 0.0 && min_iterations_before_stop >= 0;
 }
 
 bool BundleAdjustmentProblem::Check(std::string* reason) const {

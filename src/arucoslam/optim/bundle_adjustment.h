@@ -26,6 +26,11 @@ struct BundleAdjustmentOptions {
   int num_threads = 1;
   // Relative decrease of the cost below which the solver stops.
   double function_tolerance = 1e-6;
+  // Asked after each solver iteration from iteration min_iterations_before_stop on: true ends
+  // the solve there, with the best iterate so far (a usable solution; stopped_early in the
+  // summary). Unset: never asked. Local mapping yields with it to a keyframe that waits.
+  std::function<bool()> stop_requested;
+  int min_iterations_before_stop = 1;
 
   bool Check() const;
 };
@@ -68,6 +73,7 @@ struct BundleAdjustmentSummary {
   // Per observation: true when it is an outlier after the solve (chi-square test).
   std::vector<bool> outliers;
   int num_outliers = 0;
+  bool stopped_early = false;  // ended by stop_requested before convergence or max_iterations
   std::string message;  // the solver's termination message or the reason of a failure
 
   std::string BriefReport() const;

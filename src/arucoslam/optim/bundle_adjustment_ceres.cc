@@ -187,10 +187,14 @@ BundleAdjustmentSummary SolveBundleAdjustment(const BundleAdjustmentOptions& opt
   solver_options.function_tolerance = options.function_tolerance;
   solver_options.num_threads = options.num_threads;
   solver_options.logging_type = ceres::SILENT;
+  ceres_internal::StopRequestCallback stop(options.stop_requested,
+                                           options.min_iterations_before_stop);
+  ceres_internal::AddStopRequest(options, &stop, &solver_options);
   ceres::Solver::Summary ceres_summary;
   ceres::Solve(solver_options, &ceres_problem, &ceres_summary);
 
   ceres_internal::CopySolverSummary(ceres_summary, &summary);
+  summary.stopped_early = ceres_summary.termination_type == ceres::USER_SUCCESS;
   if (summary.success) blocks.CopyTo(problem);
   summary.final_rms_px = ReprojectionRmsPixels(*problem);
   FlagOutliers(options, *problem, &summary);

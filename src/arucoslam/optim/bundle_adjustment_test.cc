@@ -108,6 +108,45 @@ TEST(BundleAdjustmentTest, PerturbedSceneConvergesToTruth) {
   }
 }
 
+TEST(BundleAdjustmentTest, StopRequestEndsTheSolveWithAUsableIterate) {
+  SyntheticSceneOptions scene_options;
+  scene_options.noise_px = 0.5;
+  const BundleAdjustmentProblem truth = MakeSyntheticScene(scene_options);
+  BundleAdjustmentProblem full = Perturb(truth, 7, 0.02, 0.1);
+  BundleAdjustmentProblem stopped = full;
+  const BundleAdjustmentSummary full_summary = SolveBundleAdjustment({}, &full);
+  ASSERT_TRUE(full_summary.success) << full_summary.message;
+  EXPECT_FALSE(full_summary.stopped_early);
+  ASSERT_GE(full_summary.num_iterations, 3);
+
+  // Asked after every iteration, it is heeded from the second on: two steps are taken.
+  int num_asked = 0;
+  BundleAdjustmentOptions options;
+  options.min_iterations_before_stop = 2;
+  options.stop_requested = [&num_asked] {
+    ++num_asked;
+    return true;
+  };
+  const BundleAdjustmentSummary summary = SolveBundleAdjustment(options, &stopped);
+  ASSERT_TRUE(summary.success) << summary.message;
+  EXPECT_TRUE(summary.stopped_early);
+  EXPECT_EQ(summary.num_iterations, 2);
+  EXPECT_EQ(num_asked, 1);
+  // Two Levenberg-Marquardt steps already took most of the error out; the full solve more.
+  EXPECT_LT(summary.final_rms_px, 0.5 * summary.initial_rms_px);
+  EXPECT_GT(summary.final_cost, full_summary.final_cost);
+  EXPECT_LT(Compare(stopped, truth).median_point_m,
+            Compare(Perturb(truth, 7, 0.02, 0.1), truth).median_point_m);
+
+  // A request that never comes changes nothing.
+  BundleAdjustmentProblem unasked = Perturb(truth, 7, 0.02, 0.1);
+  options.stop_requested = [] { return false; };
+  const BundleAdjustmentSummary unasked_summary = SolveBundleAdjustment(options, &unasked);
+  EXPECT_FALSE(unasked_summary.stopped_early);
+  EXPECT_EQ(unasked_summary.num_iterations, full_summary.num_iterations);
+  EXPECT_DOUBLE_EQ(unasked_summary.final_cost, full_summary.final_cost);
+}
+
 TEST(BundleAdjustmentTest, HuberLossResistsOutliersAndFlagsThem) {
   SyntheticSceneOptions scene_options;
   scene_options.noise_px = 0.5;

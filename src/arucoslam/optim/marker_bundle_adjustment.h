@@ -84,6 +84,7 @@ struct MarkerBundleAdjustmentSummary {
   int num_keypoint_outliers = 0;
   int num_marker_outliers = 0;
   std::optional<GroundPlane> ground_plane;  // the estimated plane, with a ground-plane prior
+  bool stopped_early = false;               // ended by solver.stop_requested
   std::string message;
 
   std::string BriefReport() const;

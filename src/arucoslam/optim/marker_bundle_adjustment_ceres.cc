@@ -334,10 +334,14 @@ MarkerBundleAdjustmentSummary SolveMarkerBundleAdjustment(
   solver_options.function_tolerance = options.solver.function_tolerance;
   solver_options.num_threads = options.solver.num_threads;
   solver_options.logging_type = ceres::SILENT;
+  ceres_internal::StopRequestCallback stop(options.solver.stop_requested,
+                                           options.solver.min_iterations_before_stop);
+  ceres_internal::AddStopRequest(options.solver, &stop, &solver_options);
   ceres::Solver::Summary ceres_summary;
   ceres::Solve(solver_options, &ceres_problem, &ceres_summary);
 
   ceres_internal::CopySolverSummary(ceres_summary, &summary);
+  summary.stopped_early = ceres_summary.termination_type == ceres::USER_SUCCESS;
   if (summary.success) blocks.CopyTo(problem);
   if (summary.success && ground_plane) {
     summary.ground_plane =

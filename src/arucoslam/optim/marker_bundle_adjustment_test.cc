@@ -89,6 +89,33 @@ TEST(MarkerBundleAdjustmentTest, FixedMarkersPullAScaledDriftedMapIntoTheWorld) 
   }
 }
 
+TEST(MarkerBundleAdjustmentTest, StopRequestEndsTheJointSolveEarly) {
+  // The start of the test above; local mapping stops its BA this way for a waiting keyframe.
+  const MarkerBundleAdjustmentProblem truth = MakeSyntheticMarkerScene(NoisyScene());
+  MarkerBundleAdjustmentProblem start = truth;
+  Distort(Sim3(1.08, Eigen::Quaterniond(Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitZ())),
+               Eigen::Vector3d(0.2, -0.1, 0.05)),
+          0.005, &start);
+  MarkerBundleAdjustmentOptions options;
+  options.solver.max_iterations = 50;
+  MarkerBundleAdjustmentProblem full = start;
+  const MarkerBundleAdjustmentSummary full_summary = SolveMarkerBundleAdjustment(options, &full);
+  ASSERT_TRUE(full_summary.success) << full_summary.message;
+  EXPECT_FALSE(full_summary.stopped_early);
+  ASSERT_GT(full_summary.num_iterations, 1);
+
+  options.solver.stop_requested = [] { return true; };
+  MarkerBundleAdjustmentProblem stopped = start;
+  const MarkerBundleAdjustmentSummary summary = SolveMarkerBundleAdjustment(options, &stopped);
+  ASSERT_TRUE(summary.success) << summary.message;
+  EXPECT_TRUE(summary.stopped_early);
+  EXPECT_EQ(summary.num_iterations, 1);
+  // One step was taken and kept: the map moved towards the markers, not all the way.
+  EXPECT_LT(summary.final_cost, summary.initial_cost);
+  EXPECT_GT(summary.final_cost, full_summary.final_cost);
+  EXPECT_LT(MaxCentreError(stopped, truth), MaxCentreError(start, truth));
+}
+
 TEST(MarkerBundleAdjustmentTest, WithoutMarkersTheScaleErrorStays) {
   // Control for the test above: the same start, keypoints only, the first pose held.
   const MarkerBundleAdjustmentProblem truth = MakeSyntheticMarkerScene(NoisyScene());

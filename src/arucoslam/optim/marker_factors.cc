@@ -77,6 +77,7 @@ BundleAdjustmentSummary SolveBundleAdjustmentWithMarkers(const BundleAdjustmentO
   summary.solve_seconds = joint_summary.solve_seconds;
   summary.outliers = joint_summary.keypoint_outliers;
   summary.num_outliers = joint_summary.num_keypoint_outliers;
+  summary.stopped_early = joint_summary.stopped_early;
   summary.message = joint_summary.message;
   return summary;
 }

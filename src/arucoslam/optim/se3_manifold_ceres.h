@@ -5,6 +5,8 @@
 #include <ceres/ceres.h>
 
 #include <array>
+#include <functional>
+#include <utility>
 
 #include "arucoslam/geometry/rigid3.h"
 
@@ -70,6 +72,31 @@ void CopySolverSummary(const ceres::Solver::Summary& ceres_summary, Summary* sum
   summary->initial_cost = ceres_summary.initial_cost;
   summary->final_cost = ceres_summary.final_cost;
   summary->message = ceres_summary.message;
+}
+
+// Ends a solve after an iteration once `stop_requested` says so (from iteration
+// `min_iteration` on): Ceres keeps the best iterate reached and reports USER_SUCCESS.
+class StopRequestCallback : public ceres::IterationCallback {
+ public:
+  StopRequestCallback(std::function<bool()> stop_requested, int min_iteration)
+      : stop_requested_(std::move(stop_requested)), min_iteration_(min_iteration) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& iteration) override {
+    if (iteration.iteration >= min_iteration_ && stop_requested_()) {
+      return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+    }
+    return ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  std::function<bool()> stop_requested_;
+  int min_iteration_;
+};
+
+// Registers `callback` with `solver_options` when the bundle-adjustment options ask for stops.
+template <typename Options>
+void AddStopRequest(const Options& options, StopRequestCallback* callback,
+                    ceres::Solver::Options* solver_options) {
+  if (options.stop_requested) solver_options->callbacks.push_back(callback);
 }
 
 }  // namespace arucoslam::ceres_internal

@@ -48,8 +48,7 @@ System::System(const CameraModel& camera, const SystemOptions& options)
   if (!options_.Check()) throw std::invalid_argument("System: invalid SystemOptions");
   map_ = std::make_unique<Map>();
   tracker_ = std::make_unique<Tracker>(*map_, options_.tracker);
-  mapper_ = std::make_unique<LocalMapper>(*map_, options_.mapper);
-  GuardMarkerKeyframes();
+  MakeLocalMapper();
   if (options_.marker_map) {
     detector_ = std::make_unique<MarkerDetector>(options_.detector);
     detector_worker_ = std::make_unique<MarkerDetectorWorker>(*detector_);
@@ -111,6 +110,15 @@ void System::WaitForMapping() {
   mapped_.wait(lock, [this] { return keyframes_mapped_ >= keyframes_queued_; });
 }
 
+void System::MakeLocalMapper() {
+  mapper_ = std::make_unique<LocalMapper>(*map_, options_.mapper);
+  GuardMarkerKeyframes();
+  if (!options_.blocking && options_.yield_bundle_adjustment) {
+    // queue_ is replaced only while the mapping thread is stopped.
+    mapper_->SetYieldRequest([this] { return queue_ && queue_->Size() > 0; });
+  }
+}
+
 bool System::MapperIdle() const {
   if (options_.blocking) return true;
   return !mapping_busy_ && queue_->Size() == 0;
@@ -123,6 +131,7 @@ void System::MapKeyframe(KeyframeId keyframe) {
   FeedMarkerMapping(keyframe);
   CorrectDriftWithMarkers(keyframe);
   const LocalMappingResult r = mapper_->ProcessKeyframe(keyframe);
+  const bool yielded = r.bundle_adjustment.summary.stopped_early;
   const double elapsed = watch.ElapsedMilliseconds();
   if (places_) {
     edit.unlock();
@@ -131,14 +140,18 @@ void System::MapKeyframe(KeyframeId keyframe) {
   }
   ARUCOSLAM_LOG_DEBUG(
       "keyframe {}: {} culled, {} new ({:.0f} ms), {} fused ({:.0f} ms), BA {} kf {} pts "
-      "rms {:.2f}->{:.2f} px, {} outliers ({:.0f} ms), {} keyframes culled; {:.0f} ms",
-      keyframe.value, r.num_culled_points, r.num_new_points, r.triangulation_ms,
-      r.num_fused_points, r.fusion_ms, r.bundle_adjustment.num_local_keyframes,
-      r.bundle_adjustment.num_points, r.bundle_adjustment.summary.initial_rms_px,
-      r.bundle_adjustment.summary.final_rms_px, r.bundle_adjustment.num_erased_observations,
-      r.bundle_adjustment_ms, r.num_culled_keyframes, elapsed);
+      "rms {:.2f}->{:.2f} px{}, {} outliers ({:.0f} ms), {} keyframes culled; {:.0f} ms",
+      keyframe.value, r.num_culled_points, r.num_new_points, r.triangulation_ms, r.num_fused_points,
+      r.fusion_ms, r.bundle_adjustment.num_local_keyframes, r.bundle_adjustment.num_points,
+      r.bundle_adjustment.summary.initial_rms_px, r.bundle_adjustment.summary.final_rms_px,
+      yielded ? fmt::format(" (yielded after {} iterations)",
+                            r.bundle_adjustment.summary.num_iterations)
+              : std::string(),
+      r.bundle_adjustment.num_erased_observations, r.bundle_adjustment_ms, r.num_culled_keyframes,
+      elapsed);
   std::lock_guard lock(stats_mutex_);
   stats_.local_mapping_ms.Add(elapsed);
+  if (yielded) ++stats_.num_yielded_bundle_adjustments;
 }
 
 FrameReport System::ProcessImage(const cv::Mat& grey, double timestamp_s) {
@@ -464,8 +477,7 @@ void System::ResetMap() {
   mapper_.reset();
   map_ = std::make_unique<Map>();
   tracker_ = std::make_unique<Tracker>(*map_, options_.tracker);
-  mapper_ = std::make_unique<LocalMapper>(*map_, options_.mapper);
-  GuardMarkerKeyframes();
+  MakeLocalMapper();
   MakePlaceRecognition();
   HoldBridgePriors({});  // the new places hold none yet; the marker mapper drops them
   const int marker_generation = ResetMarkerMapping();

@@ -53,6 +53,10 @@ struct SystemOptions {
   // ProcessImage returns (deterministic). false: local mapping runs on its own thread.
   bool blocking = true;
   int mapper_queue_capacity = 3;  // keyframes waiting for the mapping thread
+  // Threaded mode: a local BA ends after its current iteration (at least one) once another
+  // keyframe waits in the queue, so a new view gets its points mapped without waiting for
+  // the BAs of the keyframes before it (ORB-SLAM's abort). Blocking mode: no keyframe waits.
+  bool yield_bundle_adjustment = true;
   // Threaded mode: while the map holds at most this many keyframes, tracking waits until
   // each new keyframe is mapped before it takes the next frame, as in blocking mode. A young
   // map tracked ahead of its local BA drifts in scale: a map started after a loss on the
@@ -322,6 +326,7 @@ struct SystemStats {
   int num_map_merges = 0;  // closed maps absorbed by a later map in the world
   int num_refined_frame_poses = 0;  // frames re-optimised against the final map at Finish
   int num_bridged_gaps = 0;         // merged maps corrected with a bridge over their gap
+  int num_yielded_bundle_adjustments = 0;  // local BAs ended early for a waiting keyframe
   int num_inconsistent_poses = 0;   // frames left out of Trajectory (pose_consistency)
 };
 
@@ -546,6 +551,9 @@ class System {
   // alignment's anchors (read by the mapping thread's keyframe culling).
   std::atomic<bool> keep_marker_keyframes_{true};
   void GuardMarkerKeyframes();
+  // A new mapper_ for map_: marker-keyframe guard, and in threaded mode the BA's yield to a
+  // waiting keyframe (yield_bundle_adjustment).
+  void MakeLocalMapper();
   int next_alignment_anchors_ = 0;  // alignment is tried again at this many anchors
   int lost_with_markers_ = 0;
   // Timestamp of the last frame whose marker location agreed with its keypoint pose, the map

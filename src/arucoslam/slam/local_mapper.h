@@ -52,6 +52,7 @@ struct LocalMapperOptions {
   LocalBundleAdjustmentOptions bundle_adjustment = [] {
     LocalBundleAdjustmentOptions options;
     options.min_fixed_keyframes = 2;
+    options.solver.min_iterations_before_stop = 5;
     return options;
   }();
   // Keyframe culling: a covisible keyframe (not the first) is erased when this fraction of
@@ -103,6 +104,12 @@ class LocalMapper {
   // Keyframes for which `keep` returns true are never culled (e.g. those anchoring a pending
   // world alignment). Set before mapping starts; called on the mapping thread.
   void SetKeyframeGuard(std::function<bool(const Keyframe&)> keep) { keep_ = std::move(keep); }
+  // Asked after each local BA iteration (from the first on): true ends the BA there, with the
+  // iterate reached (e.g. while another keyframe waits to be mapped, as ORB-SLAM's abort).
+  // Set before mapping starts; called on the mapping thread.
+  void SetYieldRequest(std::function<bool()> yield) {
+    options_.bundle_adjustment.solver.stop_requested = std::move(yield);
+  }
 
  private:
   Map& map_;

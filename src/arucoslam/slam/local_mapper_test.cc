@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <random>
 
@@ -253,6 +254,57 @@ TEST(LocalMapper, CullsRedundantKeyframesOneAtATime) {
     EXPECT_EQ(data.CheckInvariants(), "");
     return 0;
   });
+}
+
+// Local BA of keyframe 12 in a map of four keyframes whose points were moved off their
+// true positions, with `yield` as the mapper's yield request, heeded from the first iteration.
+LocalMappingResult MapPerturbedKeyframe(std::function<bool()> yield) {
+  Scene scene(4);
+  Map map;
+  const auto keyframes = BuildMap(scene, map, {0, 4, 8, 12}, [](int j) { return j % 2 == 0; });
+  std::mt19937 random(5);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  map.Write([&](MapData& data) {
+    std::vector<std::pair<MapPointId, Eigen::Vector3d>> moved;
+    for (const auto& [id, point] : data.map_points()) {
+      moved.emplace_back(
+          id, point.p_in_world + Eigen::Vector3d(noise(random), noise(random), noise(random)));
+    }
+    for (const auto& [id, p_in_world] : moved) data.SetMapPointPosition(id, p_in_world);
+    return 0;
+  });
+  LocalMapperOptions options;
+  options.bundle_adjustment.solver.min_iterations_before_stop = 1;
+  LocalMapper mapper(map, options);
+  if (yield) mapper.SetYieldRequest(std::move(yield));
+  return mapper.ProcessKeyframe(keyframes.back().id);
+}
+
+TEST(LocalMapper, BundleAdjustmentYieldsAfterItsMinimumIterations) {
+  const LocalMappingResult full = MapPerturbedKeyframe({});
+  const BundleAdjustmentSummary& full_summary = full.bundle_adjustment.summary;
+  ASSERT_TRUE(full_summary.success) << full_summary.message;
+  EXPECT_FALSE(full_summary.stopped_early);
+  ASSERT_GT(full_summary.num_iterations, 1);
+
+  int num_asked = 0;
+  const LocalMappingResult yielded = MapPerturbedKeyframe([&num_asked] {
+    ++num_asked;
+    return true;
+  });
+  const BundleAdjustmentSummary& summary = yielded.bundle_adjustment.summary;
+  ASSERT_TRUE(summary.success) << summary.message;
+  EXPECT_TRUE(summary.stopped_early);
+  EXPECT_EQ(summary.num_iterations, 1);
+  EXPECT_EQ(num_asked, 1);
+  EXPECT_TRUE(yielded.bundle_adjustment.applied);
+  // The step taken was kept: the error is smaller, not yet as small as after the full BA.
+  EXPECT_LT(summary.final_cost, summary.initial_cost);
+  EXPECT_GT(summary.final_cost, full_summary.final_cost);
+
+  const LocalMappingResult never = MapPerturbedKeyframe([] { return false; });
+  EXPECT_FALSE(never.bundle_adjustment.summary.stopped_early);
+  EXPECT_EQ(never.bundle_adjustment.summary.num_iterations, full_summary.num_iterations);
 }
 
 TEST(LocalMapper, TrackingAndMappingGrowAnAccurateMap) {
