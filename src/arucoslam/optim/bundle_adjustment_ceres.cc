@@ -189,7 +189,7 @@ BundleAdjustmentSummary SolveBundleAdjustment(const BundleAdjustmentOptions& opt
   solver_options.logging_type = ceres::SILENT;
   ceres_internal::StopRequestCallback stop(options.stop_requested,
                                            options.min_iterations_before_stop);
-  ceres_internal::AddStopRequest(options, &stop, &solver_options);
+  stop.RegisterWith(&solver_options);
   ceres::Solver::Summary ceres_summary;
   ceres::Solve(solver_options, &ceres_problem, &ceres_summary);
 

@@ -112,8 +112,9 @@ TEST(BundleAdjustmentTest, StopRequestEndsTheSolveWithAUsableIterate) {
   SyntheticSceneOptions scene_options;
   scene_options.noise_px = 0.5;
   const BundleAdjustmentProblem truth = MakeSyntheticScene(scene_options);
-  BundleAdjustmentProblem full = Perturb(truth, 7, 0.02, 0.1);
-  BundleAdjustmentProblem stopped = full;
+  const BundleAdjustmentProblem start = Perturb(truth, 7, 0.02, 0.1);
+  BundleAdjustmentProblem full = start;
+  BundleAdjustmentProblem stopped = start;
   const BundleAdjustmentSummary full_summary = SolveBundleAdjustment({}, &full);
   ASSERT_TRUE(full_summary.success) << full_summary.message;
   EXPECT_FALSE(full_summary.stopped_early);
@@ -135,11 +136,10 @@ TEST(BundleAdjustmentTest, StopRequestEndsTheSolveWithAUsableIterate) {
   // Two Levenberg-Marquardt steps already took most of the error out; the full solve more.
   EXPECT_LT(summary.final_rms_px, 0.5 * summary.initial_rms_px);
   EXPECT_GT(summary.final_cost, full_summary.final_cost);
-  EXPECT_LT(Compare(stopped, truth).median_point_m,
-            Compare(Perturb(truth, 7, 0.02, 0.1), truth).median_point_m);
+  EXPECT_LT(Compare(stopped, truth).median_point_m, Compare(start, truth).median_point_m);
 
   // A request that never comes changes nothing.
-  BundleAdjustmentProblem unasked = Perturb(truth, 7, 0.02, 0.1);
+  BundleAdjustmentProblem unasked = start;
   options.stop_requested = [] { return false; };
   const BundleAdjustmentSummary unasked_summary = SolveBundleAdjustment(options, &unasked);
   EXPECT_FALSE(unasked_summary.stopped_early);

@@ -336,7 +336,7 @@ MarkerBundleAdjustmentSummary SolveMarkerBundleAdjustment(
   solver_options.logging_type = ceres::SILENT;
   ceres_internal::StopRequestCallback stop(options.solver.stop_requested,
                                            options.solver.min_iterations_before_stop);
-  ceres_internal::AddStopRequest(options.solver, &stop, &solver_options);
+  stop.RegisterWith(&solver_options);
   ceres::Solver::Summary ceres_summary;
   ceres::Solve(solver_options, &ceres_problem, &ceres_summary);
 

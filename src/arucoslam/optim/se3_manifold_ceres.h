@@ -80,6 +80,10 @@ class StopRequestCallback : public ceres::IterationCallback {
  public:
   StopRequestCallback(std::function<bool()> stop_requested, int min_iteration)
       : stop_requested_(std::move(stop_requested)), min_iteration_(min_iteration) {}
+  // Joins the solve's callbacks when a stop can be requested (nothing to ask otherwise).
+  void RegisterWith(ceres::Solver::Options* solver_options) {
+    if (stop_requested_) solver_options->callbacks.push_back(this);
+  }
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& iteration) override {
     if (iteration.iteration >= min_iteration_ && stop_requested_()) {
       return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
@@ -91,12 +95,5 @@ class StopRequestCallback : public ceres::IterationCallback {
   std::function<bool()> stop_requested_;
   int min_iteration_;
 };
-
-// Registers `callback` with `solver_options` when the bundle-adjustment options ask for stops.
-template <typename Options>
-void AddStopRequest(const Options& options, StopRequestCallback* callback,
-                    ceres::Solver::Options* solver_options) {
-  if (options.stop_requested) solver_options->callbacks.push_back(callback);
-}
 
 }  // namespace arucoslam::ceres_internal
