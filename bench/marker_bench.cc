@@ -88,6 +88,17 @@ void BM_DetectThresholdLineFit(benchmark::State& state) {
 }
 BENCHMARK(BM_DetectThresholdLineFit)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
+// The default options at 640x480 with the edge refit of 15-60 px markers' corners (1, the
+// default) or cornerSubPix's corners only (0).
+void BM_DetectEdgeRefinement(benchmark::State& state) {
+  const cv::Mat image = RenderSyntheticView(Camera(640, 480), Markers(), {});
+  DetectorOptions options;
+  options.edge_refinement = state.range(0) != 0;
+  const MarkerDetector detector(options);
+  TimeDetection(state, detector, image);
+}
+BENCHMARK(BM_DetectEdgeRefinement)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
 // The small-marker options of DetectorOptions at 640x480: upsample factor x 10 (10: none)
 // and the second decoding of rejected candidates (0 or 1).
 void BM_DetectSmallMarkerOptions(benchmark::State& state) {

@@ -151,7 +151,8 @@ void AddLocateCommand(CLI::App& app, int& exit_status) {
   locate->add_flag("--clahe", args->clahe, "equalise contrast (CLAHE) before detection");
   locate
       ->add_option("--refinement", args->refinement,
-                   "corner refinement: none, subpix, contour or apriltag")
+                   "corner refinement: none, subpix (20-60 px markers then refitted to their "
+                   "edges), contour or apriltag")
       ->capture_default_str();
   locate
       ->add_option("--inlier-threshold", args->inlier_threshold_px,

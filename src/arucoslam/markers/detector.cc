@@ -36,7 +36,12 @@ bool DetectorOptions::Check() const {
          dedup_distance_rate >= 0.0 && marker_border_bits >= 1 &&
          (april_tag_quad_decimate == 0.0 || april_tag_quad_decimate >= 1.0) &&
          april_tag_quad_sigma >= 0.0 && upsample >= 1.0 && upsample <= 8.0 && rescue.Check() &&
-         threshold_fit.Check() && april_tag_quad_match_cells > 0.0;
+         threshold_fit.Check() && april_tag_quad_match_cells > 0.0 &&
+         edge_refinement_min_side_px >= 0.0 &&
+         edge_refinement_max_side_px >= edge_refinement_min_side_px &&
+         edge_refinement_options.search_cells > 0.0 &&
+         edge_refinement_options.derivative_half_width_px > 0.0 &&
+         edge_refinement_options.iterations >= 1;
 }
 
 cv::Ptr<cv::aruco::DetectorParameters> DetectorOptions::ToOpenCv() const {
@@ -255,7 +260,9 @@ std::vector<MarkerDetection> MarkerDetector::DetectInGray(
                                                detections[i].corners);
     }
   }
-  if (options_.threshold_line_fit) {
+  // Refits each detection's corners (not those on an AprilTag quad) with `fit`, which takes
+  // them as found and returns false to keep them.
+  const auto refit_corners = [&](const auto& fit) {
     for (size_t i = 0; i < detections.size(); ++i) {
       if (on_april_tag_quad[i]) continue;
       MarkerDetection& detection = detections[i];
@@ -264,9 +271,25 @@ std::vector<MarkerDetection> MarkerDetector::DetectInGray(
         fitted[k] = cv::Point2f(static_cast<float>(detection.corners[k].x()),
                                 static_cast<float>(detection.corners[k].y()));
       }
-      if (!FitQuadToThreshold(gray, cells, options_.threshold_fit, fitted)) continue;
+      if (!fit(detection, fitted)) continue;
       for (int k = 0; k < 4; ++k) detection.corners[k] = {fitted[k].x, fitted[k].y};
     }
+  };
+  // Not with wider borders: in an AprilGrid (2-cell border, small black squares between the
+  // tags) the fit took a neighbour's edge (yac_mocap_aprilgrid: corners up to 8.5 px off).
+  if (options_.edge_refinement && options_.corner_refinement == CornerRefinement::kSubpix &&
+      options_.marker_border_bits == 1 && !options_.threshold_line_fit) {
+    refit_corners([&](const MarkerDetection& detection, std::array<cv::Point2f, 4>& fitted) {
+      const double side = 0.25 * detection.Perimeter();
+      return side >= options_.edge_refinement_min_side_px &&
+             side <= options_.edge_refinement_max_side_px &&
+             RefineQuadEdges(gray, cells, options_.edge_refinement_options, fitted);
+    });
+  }
+  if (options_.threshold_line_fit) {
+    refit_corners([&](const MarkerDetection&, std::array<cv::Point2f, 4>& fitted) {
+      return FitQuadToThreshold(gray, cells, options_.threshold_fit, fitted);
+    });
   }
   return detections;
 }

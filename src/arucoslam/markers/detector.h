@@ -11,6 +11,7 @@
 
 #include "arucoslam/markers/april_tag_quads.h"
 #include "arucoslam/markers/candidate_decoder.h"
+#include "arucoslam/markers/edge_refiner.h"
 #include "arucoslam/markers/threshold_line_fit.h"
 
 namespace arucoslam {
@@ -98,6 +99,23 @@ struct DetectorOptions {
   // 640x480 frame with 4 markers; BM_DetectAprilTagPhoto: 222 against 212 ms for 30 tags).
   bool threshold_line_fit = false;
   ThresholdLineFitOptions threshold_fit;
+  // kSubpix, 1-cell border: markers edge_refinement_min_side_px to edge_refinement_max_side_px
+  // on a side (mean, input pixels) get their corners refitted from their four edges
+  // (edge_refiner.h); kept as cornerSubPix left them where the fit fails. cornerSubPix, with its
+  // window of 0.6 cells, leaves a small blurred marker's corners inside the true ones: on the
+  // simulator's factory route, 20-40 px markers are 0.14-0.22 px too small at each corner
+  // (0.17-0.25 px RMS), the edge fit 0.00-0.02 px (0.05-0.08 px RMS), and the camera position from
+  // one 20-40 px marker improves from 0.20 to 0.12 m mean (detector_test.cc,
+  // EdgeRefinementRemovesTheInwardBiasOfSmallMarkers, for rendered markers). Under 20 px the
+  // border is under 3.3 px wide and the fit can take the edge of a board around the marker
+  // (15-20 px markers on the factory's wall boards: +0.14 px outward, 0.30 px RMS). Over 60 px
+  // cornerSubPix's bias is under 0.1 px and a whole side is no longer straight in a distorted
+  // image: on the fiducials_aruco_unit photos (sides of 100-200 px, raw) the edge fit moves
+  // corners up to 0.7 px from the peer's cornerSubPix ones.
+  bool edge_refinement = true;
+  double edge_refinement_min_side_px = 20.0;
+  double edge_refinement_max_side_px = 60.0;
+  EdgeRefineOptions edge_refinement_options = {.derivative_half_width_px = 0.5};
   // AprilTag dictionaries (DICT_APRILTAG_*) with the standard 1-cell border only: each
   // detection, whatever found it, takes the corners of the AprilTag quad fit on the input
   // image (april_tag_quads.h; where the apriltag library places them) when one of its quads

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -334,6 +335,7 @@ TEST(MarkerDetectorTest, ThresholdLineFitCornersOnRenderedMarkers) {
       const cv::Mat image =
           ThroughJpeg(RenderSyntheticView(SyntheticCamera640(), markers, view), 85);
       for (int variant = 0; variant < variants; ++variant) {
+        options.edge_refinement = false;  // variant 0: the corners as OpenCV and cornerSubPix give
         options.threshold_line_fit = variant == 1;
         options.april_tag_quad_corners = variant == 2;
         AddCornerErrors(MarkerDetector(options).Detect(image), markers, &error_sum[variant],
@@ -354,6 +356,59 @@ TEST(MarkerDetectorTest, ThresholdLineFitCornersOnRenderedMarkers) {
       EXPECT_LT(error_sum[2] / corners[2], 0.2);
     }
   }
+}
+
+// Markers of 20-50 px a side (0.2 m at 2-5 m), tilted up to 40 degrees, blurred and noisy:
+// cornerSubPix with its window of 0.6 cells leaves each corner inside the true one (the
+// contour it starts from lies inside the blurred border), so the marker looks smaller and
+// farther than it is. The edge fit (edge_refinement, on by default) removes that bias.
+// Measured over 47 markers of 22-50 px: mean outward offset -0.245 px and 0.266 px RMS with
+// cornerSubPix only, +0.007 px and 0.062 px RMS with the edge fit.
+TEST(MarkerDetectorTest, EdgeRefinementRemovesTheInwardBiasOfSmallMarkers) {
+  DetectorOptions subpix_only;
+  subpix_only.edge_refinement = false;
+  const MarkerDetector detectors[2] = {MarkerDetector(subpix_only), MarkerDetector()};
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  double outward_sum[2] = {0.0, 0.0}, squared_sum[2] = {0.0, 0.0};
+  int corners[2] = {0, 0};
+  for (int trial = 0; trial < 60; ++trial) {
+    const double depth = 2.0 + 3.0 * unit(rng);
+    SyntheticMarker marker = RandomMarker(depth, 0.7 * unit(rng), rng);
+    SyntheticViewOptions view;
+    view.seed = 300 + trial;
+    view.blur_sigma_px = 0.5 + 0.5 * unit(rng);
+    view.noise_sigma = 2.0 + 2.0 * unit(rng);
+    const cv::Mat image = RenderSyntheticView(SyntheticCamera640(), {marker}, view);
+    const std::array<Eigen::Vector2d, 4> truth = ProjectMarkerCorners(SyntheticCamera640(), marker);
+    const Eigen::Vector2d centre = 0.25 * (truth[0] + truth[1] + truth[2] + truth[3]);
+    double side = 0.0;
+    for (int k = 0; k < 4; ++k) side += 0.25 * (truth[(k + 1) % 4] - truth[k]).norm();
+    if (side < 22.0) continue;  // the option's range starts at 20 px (a detection's own side)
+    for (int variant = 0; variant < 2; ++variant) {
+      for (const MarkerDetection& d : detectors[variant].Detect(image)) {
+        ASSERT_EQ(d.id, marker.id);
+        for (int k = 0; k < 4; ++k) {
+          const Eigen::Vector2d error = d.corners[k] - truth[k];
+          outward_sum[variant] += error.dot((truth[k] - centre).normalized());
+          squared_sum[variant] += error.squaredNorm();
+          ++corners[variant];
+        }
+      }
+    }
+  }
+  double outward[2], rms[2];
+  for (int variant = 0; variant < 2; ++variant) {
+    outward[variant] = outward_sum[variant] / corners[variant];
+    rms[variant] = std::sqrt(squared_sum[variant] / corners[variant]);
+    std::printf("%s: %d corners, mean outward offset %+.3f px, RMS %.3f px\n",
+                variant ? "edge refinement" : "cornerSubPix only", corners[variant],
+                outward[variant], rms[variant]);
+  }
+  EXPECT_EQ(corners[1], corners[0]);
+  EXPECT_GE(corners[1], 4 * 40);
+  EXPECT_LT(std::abs(outward[1]), 0.04);
+  EXPECT_LT(rms[1], 0.6 * rms[0]);
 }
 
 // Tilted tag36h11 markers of 3, 4.5 and 6 px per cell (blur, noise, JPEG) with the default
@@ -389,6 +444,9 @@ TEST(MarkerDetectorTest, AprilTagQuadCornersOnRenderedMarkers) {
     view.blur_sigma_px = 0.6 + 0.1 * image_index;
     const cv::Mat image = ThroughJpeg(RenderSyntheticView(SyntheticCamera640(), markers, view), 90);
     for (const bool quad_corners : {false, true}) {
+      // Against cornerSubPix alone. With the edge refinement (the default, skipped for corners
+      // on an AprilTag quad) these corners were measured at 0.062 px mean.
+      options.edge_refinement = false;
       options.april_tag_quad_corners = quad_corners;
       AddCornerErrors(MarkerDetector(options).Detect(image), markers, &error_sum[quad_corners],
                       &corners[quad_corners]);

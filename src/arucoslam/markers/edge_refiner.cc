@@ -27,7 +27,7 @@ double GreyAt(const cv::Mat& gray, double x, double y) {
 // too few edge points.
 std::optional<FittedLine> FitSide(const cv::Mat& gray, cv::Point2d a, cv::Point2d b,
                                   cv::Point2d outward, double search_px, double min_fraction,
-                                  double min_step) {
+                                  double min_step, double derivative_half_width_px) {
   const double length = cv::norm(b - a);
   const int samples = std::clamp(static_cast<int>(length / 1.5), 4, 24);
   const double step = 0.25;  // px along the normal
@@ -43,11 +43,12 @@ std::optional<FittedLine> FitSide(const cv::Mat& gray, cv::Point2d a, cv::Point2
       const cv::Point2d q = p + (k * step) * outward;
       profile[k + half + 1] = GreyAt(gray, q.x, q.y);
     }
-    // Derivative over +-1 px (differences of 4 steps each way): steady on noisy JPEG.
+    // Derivative over +-derivative_half_width_px (in steps of 0.25 px each way).
+    const int reach = std::max(1, static_cast<int>(std::lround(derivative_half_width_px / step)));
     std::vector<double> derivative(profile.size(), 0.0);
     int peak = -1;
     for (int i = 1; i + 1 < static_cast<int>(profile.size()); ++i) {
-      const int lo = std::max(0, i - 4), hi = std::min<int>(profile.size() - 1, i + 4);
+      const int lo = std::max(0, i - reach), hi = std::min<int>(profile.size() - 1, i + reach);
       derivative[i] = (profile[hi] - profile[lo]) / ((hi - lo) * step);
       if (peak < 0 || std::abs(derivative[i]) > std::abs(derivative[peak])) peak = i;
     }
@@ -98,7 +99,7 @@ bool RefineQuadEdges(const cv::Mat& gray, int cells, const EdgeRefineOptions& op
       const cv::Point2d outward(along.y, -along.x);
       const std::optional<FittedLine> line =
           FitSide(gray, a, b, outward, options.search_cells * cell, options.min_edge_fraction,
-                  options.min_step);
+                  options.min_step, options.derivative_half_width_px);
       if (!line) return false;
       lines[k] = *line;
     }

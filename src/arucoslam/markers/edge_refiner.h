@@ -17,6 +17,10 @@ struct EdgeRefineOptions {
   // An edge point needs a dark-to-bright step of at least this many grey levels over 2 px.
   double min_step = 12.0;
   double max_shift_cells = 0.75;  // a corner moving further fails the refinement
+  // Half width of the difference that gives the grey profile's derivative, pixels. 1 steadies
+  // it on noisy JPEG photos; 0.5 locates the edge of a small sharp marker better (rendered
+  // markers of 15-30 px: 0.05-0.07 px RMS corner error against 0.06-0.11 px with 1).
+  double derivative_half_width_px = 1.0;
 };
 
 // `corners`: clockwise on screen (y down), `cells` cells across the quadrilateral. Returns

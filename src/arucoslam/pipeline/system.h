@@ -83,7 +83,16 @@ struct SystemOptions {
   // aligned to the world (Sim3, metric scale), tracking restarts from marker poses, and
   // aligned frames are optimised with the markers' corners. Unset: keypoints only.
   std::optional<MarkerMap> marker_map;
-  DetectorOptions detector;
+  // The detector's defaults, but without the edge refit of 20-60 px markers' corners
+  // (DetectorOptions::edge_refinement): its corners are the more accurate ones, yet in six
+  // blocking runs on simulated routes the SLAM with them was worse in four (the default
+  // world 0.100 -> 0.132-0.146 m world ATE, one 2 m board seed 0.038 -> 0.092-0.381 m) and
+  // better in two (BENCHMARKS.md, "Marker corners refitted from their edges").
+  DetectorOptions detector = [] {
+    DetectorOptions options;
+    options.edge_refinement = false;
+    return options;
+  }();
   // Where each image's markers are searched: the whole image every full_scan_interval
   // frames and whenever the previous frame has no pose in the marker world, else around the
   // known (and mapped) markers projected with that pose and the previous frame's detections
