@@ -10,7 +10,8 @@
 namespace arucoslam {
 
 bool EvaluationOptions::Check() const {
-  if (!association.Check() || !alignment.Check() || !per_axis.Check() || !completeness.Check()) {
+  if (!association.Check() || !alignment.Check() || !per_axis.Check() || !completeness.Check() ||
+      (scale_drift && !scale_drift->Check())) {
     return false;
   }
   for (const RelativeErrorOptions& r : relative) {
@@ -92,6 +93,8 @@ TrajectoryEvaluation EvaluateTrajectory(const Trajectory& gt, const Trajectory& 
   }
   result.per_axis = ComputePerAxisError(gt_pairs, result.aligned_est, options.per_axis);
   result.completeness = ComputeCompleteness(gt, est, options.completeness);
+  if (options.scale_drift)
+    result.scale_drift = ComputeScaleDrift(result.pairs, *options.scale_drift);
   return result;
 }
 

@@ -12,6 +12,7 @@
 #include "arucoslam/eval/map_accuracy.h"
 #include "arucoslam/eval/per_axis_error.h"
 #include "arucoslam/eval/pose_error.h"
+#include "arucoslam/eval/scale_drift.h"
 #include "arucoslam/eval/statistics.h"
 
 namespace arucoslam {
@@ -25,6 +26,8 @@ struct EvaluationOptions {
   CompletenessOptions completeness;  // gap threshold automatic
   // Pair poses by index instead of time (both files without time, e.g. KITTI).
   bool associate_by_index = false;
+  // Set: the Sim(3) scale over consecutive windows of this many seconds (scale_drift.h).
+  std::optional<ScaleDriftOptions> scale_drift;
 
   bool Check() const;
 };
@@ -52,6 +55,7 @@ struct TrajectoryEvaluation {
   std::vector<RelativeErrorResult> relative;
   PerAxisError per_axis;
   Completeness completeness;
+  std::optional<ScaleDrift> scale_drift;     // when asked for and two windows are usable
   std::optional<RunTrackingStats> tracking;  // from a stats.json, when given
   std::optional<MapAccuracy> map;            // when map points and a world are given
 };

@@ -63,6 +63,19 @@ std::vector<Row> RunRows(const std::vector<TrajectoryEvaluation>& evaluations) {
   add("Sim3 scale / scale error", [](const TrajectoryEvaluation& e) {
     return fmt::format("{:.4f} / {:.2f}%", e.sim3_scale, 100.0 * e.scale_error);
   });
+  const bool any_drift =
+      std::any_of(evaluations.begin(), evaluations.end(),
+                  [](const TrajectoryEvaluation& e) { return e.scale_drift.has_value(); });
+  if (any_drift) {
+    add("scale drift: last / first window - 1", [](const TrajectoryEvaluation& e) {
+      return e.scale_drift ? fmt::format("{:+.2f}%", 100.0 * e.scale_drift->last_over_first)
+                           : std::string("-");
+    });
+    add("windowed scale min / max", [](const TrajectoryEvaluation& e) {
+      return e.scale_drift ? fmt::format("{:.4f} / {:.4f}", e.scale_drift->min, e.scale_drift->max)
+                           : std::string("-");
+    });
+  }
   add("completeness [% of gt time]", [](const TrajectoryEvaluation& e) {
     return Fixed(100.0 * e.completeness.covered_fraction, 1);
   });

@@ -74,6 +74,19 @@ json EvaluationJson(const TrajectoryEvaluation& e, const std::string& file) {
         {"gaps", c.num_gaps},
         {"gap_threshold_s", c.max_gap_used}}},
   };
+  if (e.scale_drift) {
+    json windows = json::array();
+    for (const ScaleDriftWindow& w : e.scale_drift->windows) {
+      windows.push_back({{"start_s", w.start_s},
+                         {"end_s", w.end_s},
+                         {"pairs", w.num_pairs},
+                         {"estimate_per_truth", w.estimate_per_truth}});
+    }
+    out["scale_drift"] = {{"last_over_first", e.scale_drift->last_over_first},
+                          {"min", e.scale_drift->min},
+                          {"max", e.scale_drift->max},
+                          {"windows", windows}};
+  }
   if (e.tracking) {
     out["tracking"] = {{"losses", e.tracking->losses},
                        {"relocalisations", e.tracking->relocalisations}};

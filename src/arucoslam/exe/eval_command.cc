@@ -36,6 +36,7 @@ struct EvalArgs {
   std::vector<std::string> rpe = {"1frames"};
   std::vector<double> at;  // seconds from the first ground-truth pose
   double max_gap = 0.0;    // seconds, 0 = automatic
+  double scale_window = 0.0;  // seconds, 0 = no scale drift
   std::vector<std::string> stats;
   std::vector<std::string> maps;
   std::string world;
@@ -92,6 +93,13 @@ EvaluationOptions MakeOptions(const EvalArgs& args, double gt_start) {
   for (double t : args.at) options.per_axis.timestamps.push_back(gt_start + t);
   if (!(args.max_gap >= 0.0)) throw InputError("--max-gap", "expected seconds >= 0");
   options.completeness.max_gap = args.max_gap;
+  if (!(args.scale_window >= 0.0) || !std::isfinite(args.scale_window)) {
+    throw InputError("--scale-window", "expected seconds >= 0");
+  }
+  if (args.scale_window > 0.0) {
+    options.scale_drift = ScaleDriftOptions{};
+    options.scale_drift->window_s = args.scale_window;
+  }
   return options;
 }
 
@@ -192,6 +200,10 @@ void AddEvalCommand(CLI::App& app, int& exit_status) {
   eval->add_option("--max-gap", args->max_gap,
                    "completeness: poses further apart leave a gap, seconds (0: 3x the median "
                    "frame interval)")
+      ->capture_default_str();
+  eval->add_option("--scale-window", args->scale_window,
+                   "scale drift: the Sim(3) scale over consecutive windows of this many seconds "
+                   "(0: off); a monocular map growing or shrinking as it goes")
       ->capture_default_str();
   eval->add_option("--stats", args->stats,
                    "a run's stats.json per --est: {\"tracking\": {\"losses\": N, "

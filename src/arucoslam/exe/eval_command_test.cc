@@ -1,8 +1,7 @@
 // Runs the `arucoslam eval` binary: evo's numbers on its test data, the files it writes,
 // and one clear line with exit status 2 for each kind of bad input.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
-
-#include "arucoslam/exe/command_test_util.h"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -10,6 +9,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "arucoslam/exe/command_test_util.h"
 #include "arucoslam/util/files.h"
 
 namespace arucoslam {
@@ -93,6 +93,36 @@ TEST_F(EvalCommandTest, StatsFileIsReported) {
   const nlohmann::json json = nlohmann::json::parse(ReadTextFile(folder_ / "o" / "results.json"));
   EXPECT_EQ(json["estimates"][0]["tracking"]["relocalisations"], 1);
   EXPECT_EQ(json["estimates"][0]["ape"]["translation_m"]["rmse"].get<double>(), 0.0);
+}
+
+// A ground truth driving 1 m/s along x for 10 s and an estimate whose steps shrink by 2% a
+// second: windows of 2.5 s see it 2.5% smaller, then 7.5%, 12.5% and 17.5%.
+TEST_F(EvalCommandTest, ScaleDriftOverWindows) {
+  std::string gt_text, est_text;
+  double x = 0.0;
+  for (int i = 0; i < 100; ++i) {
+    const double t = i / 10.0;
+    gt_text += fmt::format("{:.2f} {:.6f} 0 0 0 0 0 1\n", 100.0 + t, 0.1 * i);
+    est_text += fmt::format("{:.2f} {:.6f} 0 0 0 0 0 1\n", 100.0 + t, x);
+    x += 0.1 * (1.0 - 0.02 * t);
+  }
+  const fs::path gt = Write("gt.txt", gt_text);
+  const fs::path est = Write("est.txt", est_text);
+  const RunResult run = Run("--gt " + gt.string() + " --est " + est.string() +
+                            " --scale-window 2.5 --out " + (folder_ / "o").string());
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_NE(run.out.find("scale drift: last / first window - 1"), std::string::npos) << run.out;
+  const nlohmann::json json = nlohmann::json::parse(ReadTextFile(folder_ / "o" / "results.json"));
+  const nlohmann::json& drift = json["estimates"][0]["scale_drift"];
+  ASSERT_EQ(drift["windows"].size(), 4u);
+  EXPECT_NEAR(drift["windows"][0]["estimate_per_truth"].get<double>(), 1.0 - 0.02 * 1.2, 2e-3);
+  EXPECT_NEAR(drift["windows"][3]["estimate_per_truth"].get<double>(), 1.0 - 0.02 * 8.7, 2e-3);
+  EXPECT_NEAR(drift["last_over_first"].get<double>(), (1.0 - 0.02 * 8.7) / (1.0 - 0.02 * 1.2) - 1.0,
+              3e-3);
+  const RunResult bad =
+      Run("--gt " + gt.string() + " --est " + est.string() + " --scale-window -1");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("--scale-window: expected seconds >= 0"), std::string::npos) << bad.err;
 }
 
 TEST_F(EvalCommandTest, MapAccuracyAgainstAnSdfWorld) {
