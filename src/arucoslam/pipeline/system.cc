@@ -539,12 +539,17 @@ std::vector<StampedPose> System::CurrentMapPoses(bool world_only) const {
 
 std::vector<StampedPose> System::KeyframePoses() const {
   std::vector<StampedPose> poses = closed_keyframes_;
-  if (options_.marker_map && !world_aligned_) return poses;  // not in the world frame
-  map_->Read([&](const MapData& data) {
-    for (const auto& [id, keyframe] : data.keyframes()) {
-      poses.push_back({keyframe.timestamp_s, keyframe.cam_from_world.Inverse()});
-    }
-    return 0;
+  if (!options_.marker_map || world_aligned_) {  // else the map is not in the world frame
+    map_->Read([&](const MapData& data) {
+      for (const auto& [id, keyframe] : data.keyframes()) {
+        poses.push_back({keyframe.timestamp_s, keyframe.cam_from_world.Inverse()});
+      }
+      return 0;
+    });
+  }
+  // Ids are not in time order once a closed map was merged (its keyframes numbered anew).
+  std::stable_sort(poses.begin(), poses.end(), [](const StampedPose& a, const StampedPose& b) {
+    return a.timestamp_s < b.timestamp_s;
   });
   return poses;
 }

@@ -372,7 +372,8 @@ class System {
   // maps, closed maps frozen). Keypoints only: the poses of the map with the most keyframes
   // (maps are in unrelated frames), as ORB-SLAM3 does.
   std::vector<StampedPose> Trajectory() const;
-  // Keyframes and points of the current map plus, with a marker map, of closed aligned maps.
+  // Keyframes (in time order) and points of the current map plus, with a marker map, of
+  // closed aligned maps.
   std::vector<StampedPose> KeyframePoses() const;
   std::vector<Eigen::Vector3d> MapPoints() const;
   const Map& map() const { return *map_; }

@@ -209,6 +209,9 @@ TEST(SystemRecovery, ClosedMapIsMergedIntoTheNextMapInTheWorld) {
   std::vector<double> output_times;
   for (const StampedPose& pose : merged.keyframes) output_times.push_back(pose.timestamp_s);
   EXPECT_EQ(CountBefore(output_times, blackout_s), first_map_keyframes);
+  // In time order (keyframes.tum): the merged map's keyframes are numbered after the new
+  // map's, and `eval` refuses a file whose time goes back.
+  EXPECT_TRUE(std::is_sorted(output_times.begin(), output_times.end()));
   EXPECT_EQ(merged.trajectory.size(), apart.trajectory.size());
   EXPECT_LT(SceneAbsoluteRmse(merged.trajectory), 0.02);
   std::printf("first map: %d keyframes merged; world RMSE merged %.4f m, apart %.4f m\n",
