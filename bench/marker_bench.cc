@@ -88,7 +88,7 @@ void BM_DetectThresholdLineFit(benchmark::State& state) {
 }
 BENCHMARK(BM_DetectThresholdLineFit)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
-// The default options at 640x480 with the edge refit of 15-60 px markers' corners (1, the
+// The default options at 640x480 with the edge refit of 20-60 px markers' corners (1, the
 // default) or cornerSubPix's corners only (0).
 void BM_DetectEdgeRefinement(benchmark::State& state) {
   const cv::Mat image = RenderSyntheticView(Camera(640, 480), Markers(), {});

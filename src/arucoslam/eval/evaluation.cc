@@ -93,8 +93,9 @@ TrajectoryEvaluation EvaluateTrajectory(const Trajectory& gt, const Trajectory& 
   }
   result.per_axis = ComputePerAxisError(gt_pairs, result.aligned_est, options.per_axis);
   result.completeness = ComputeCompleteness(gt, est, options.completeness);
-  if (options.scale_drift)
+  if (options.scale_drift) {
     result.scale_drift = ComputeScaleDrift(result.pairs, *options.scale_drift);
+  }
   return result;
 }
 

@@ -3,31 +3,22 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 #include "arucoslam/eval/alignment.h"
 
 namespace arucoslam {
 namespace {
 
-// RMS distance of the ground-truth positions with times in [start, end) to their centroid.
-double TrueExtent(const AssociatedTrajectories& pairs, double start, double end) {
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  int count = 0;
-  for (std::size_t i = 0; i < pairs.size(); ++i) {
-    const double t = pairs.gt.timestamps[i];
-    if (t < start || t >= end) continue;
-    sum += pairs.gt.poses[i].translation;
-    ++count;
-  }
-  if (count == 0) return 0.0;
-  const Eigen::Vector3d centroid = sum / count;
+// RMS distance of `positions` to their centroid; 0 for none.
+double Extent(const std::vector<Eigen::Vector3d>& positions) {
+  if (positions.empty()) return 0.0;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : positions) centroid += p;
+  centroid /= static_cast<double>(positions.size());
   double squared = 0.0;
-  for (std::size_t i = 0; i < pairs.size(); ++i) {
-    const double t = pairs.gt.timestamps[i];
-    if (t < start || t >= end) continue;
-    squared += (pairs.gt.poses[i].translation - centroid).squaredNorm();
-  }
-  return std::sqrt(squared / count);
+  for (const Eigen::Vector3d& p : positions) squared += (p - centroid).squaredNorm();
+  return std::sqrt(squared / static_cast<double>(positions.size()));
 }
 
 }  // namespace
@@ -41,10 +32,13 @@ std::optional<ScaleDrift> ComputeScaleDrift(const AssociatedTrajectories& pairs,
   ScaleDrift drift;
   for (double start = t0; start <= t_end; start += options.window_s) {
     const double end = start + options.window_s;
-    std::size_t count = 0;
-    for (const double t : pairs.gt.timestamps) count += t >= start && t < end;
-    if (count < static_cast<std::size_t>(options.min_pairs)) continue;
-    if (TrueExtent(pairs, start, end) < options.min_extent_m) continue;
+    std::vector<Eigen::Vector3d> true_positions;  // of the pairs in [start, end)
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+      const double t = pairs.gt.timestamps[i];
+      if (t >= start && t < end) true_positions.push_back(pairs.gt.poses[i].translation);
+    }
+    if (true_positions.size() < static_cast<std::size_t>(options.min_pairs)) continue;
+    if (Extent(true_positions) < options.min_extent_m) continue;
     AlignmentOptions alignment;
     alignment.mode = AlignmentMode::kSim3;
     alignment.window_start = start;

@@ -97,9 +97,7 @@ bool CandidateDecoderOptions::Check() const {
          ignored_margin_per_cell < 0.5 && min_contrast >= 0.0 && max_erroneous_border_bits >= 0 &&
          error_correction_rate >= 0.0 && error_correction_rate <= 1.0 &&
          refine_window_cells > 0.0 && max_refine_shift_cells > 0.0 && sharpening >= 0.0 &&
-         edges.search_cells > 0.0 && edges.derivative_half_width_px > 0.0 &&
-         edges.iterations >= 1 && edges.min_edge_fraction >= 0.0 &&
-         edges.min_edge_fraction <= 1.0 && edges.min_step >= 0.0 && edges.max_shift_cells > 0.0;
+         edges.Check();
 }
 
 namespace {

@@ -39,9 +39,7 @@ bool DetectorOptions::Check() const {
          threshold_fit.Check() && april_tag_quad_match_cells > 0.0 &&
          edge_refinement_min_side_px >= 0.0 &&
          edge_refinement_max_side_px >= edge_refinement_min_side_px &&
-         edge_refinement_options.search_cells > 0.0 &&
-         edge_refinement_options.derivative_half_width_px > 0.0 &&
-         edge_refinement_options.iterations >= 1;
+         edge_refinement_options.Check();
 }
 
 cv::Ptr<cv::aruco::DetectorParameters> DetectorOptions::ToOpenCv() const {

@@ -21,6 +21,12 @@ struct EdgeRefineOptions {
   // it on noisy JPEG photos; 0.5 locates the edge of a small sharp marker better (rendered
   // markers of 15-30 px: 0.05-0.07 px RMS corner error against 0.06-0.11 px with 1).
   double derivative_half_width_px = 1.0;
+
+  bool Check() const {
+    return search_cells > 0.0 && derivative_half_width_px > 0.0 && iterations >= 1 &&
+           min_edge_fraction >= 0.0 && min_edge_fraction <= 1.0 && min_step >= 0.0 &&
+           max_shift_cells > 0.0;
+  }
 };
 
 // `corners`: clockwise on screen (y down), `cells` cells across the quadrilateral. Returns
