@@ -1,6 +1,7 @@
-// `arucoslam run`: monocular SLAM over a sequence (EuRoC layout, TUM RGB-D folder or image
-// folder) -> trajectory.tum, keyframes.tum, map.ply, stats.json (and with markers
-// markers.json: the known markers and the ones mapped online) in one output folder;
+// `arucoslam run`: monocular SLAM over a sequence (EuRoC layout, TUM RGB-D folder, image
+// folder or one image topic of a ROS 1 bag) -> trajectory.tum, keyframes.tum, map.ply,
+// stats.json (and with markers markers.json: the known markers and the ones mapped online)
+// in one output folder;
 // map reuse: --save-map writes the map file after the run, --load-map starts from one,
 // --localize-only tracks against it without changing it.
 #include <cstdio>
@@ -10,6 +11,7 @@
 #include <string>
 #include <utility>
 
+#include "arucoslam/exe/bag_feed.h"
 #include "arucoslam/exe/command.h"
 #include "arucoslam/exe/default_vocabulary.h"
 #include "arucoslam/exe/slam_run.h"
@@ -25,6 +27,8 @@ struct RunArgs {
   std::string dataset;
   std::string out;
   std::string camera;
+  std::string image_topic;        // ROS bag only
+  std::string camera_info_topic;  // ROS bag only
   std::string vocabulary;  // empty: the default one
   bool no_loop_closing = false;
   std::string markers;  // overrides the sequence's markers.json
@@ -65,14 +69,26 @@ int RunSlam(const RunArgs& args) {
   if (!(args.marker_size_m >= 0.0)) {
     throw InputError("--marker-size", "expected a side >= 0 m, got " + std::to_string(args.marker_size_m));
   }
-  DatasetOptions dataset_options;
-  dataset_options.camera_path = args.camera;
-  dataset_options.rate_hz = args.rate_hz;
-  const Dataset dataset = Dataset::Open(args.dataset, dataset_options);
+  std::optional<Dataset> dataset;
+  FrameFeed frames;
+  if (IsBagDataset(args.dataset)) {
+    frames = OpenBagFeed(args.dataset, {args.image_topic, args.camera_info_topic, args.camera});
+  } else {
+    if (!args.image_topic.empty() || !args.camera_info_topic.empty()) {
+      throw InputError(args.image_topic.empty() ? "--camera-info-topic" : "--image-topic",
+                       "only for a ROS bag (--dataset FILE.bag)");
+    }
+    DatasetOptions dataset_options;
+    dataset_options.camera_path = args.camera;
+    dataset_options.rate_hz = args.rate_hz;
+    dataset = Dataset::Open(args.dataset, dataset_options);
+    frames = DatasetFeed(*dataset);
+  }
   if (std::filesystem::exists(args.out) && !std::filesystem::is_directory(args.out)) {
     throw InputError(args.out, "exists and is not a directory");
   }
-  std::optional<std::filesystem::path> markers_path = dataset.markers_path();
+  std::optional<std::filesystem::path> markers_path;
+  if (dataset) markers_path = dataset->markers_path();
   if (!args.markers.empty()) markers_path = args.markers;
   if (args.no_markers) markers_path.reset();
   if (args.ground_vehicle && !markers_path) {  // before the vocabulary's load: fail fast
@@ -92,11 +108,11 @@ int RunSlam(const RunArgs& args) {
   const bool markers = options.marker_map.has_value();
   if (args.ground_vehicle) options.marker_mapping.ground_plane_prior = GroundPlanePriorOptions{};
   MapReuse reuse;
-  if (!args.load_map.empty()) LoadMapForRun(args.load_map, dataset.camera(), reuse);
+  if (!args.load_map.empty()) LoadMapForRun(args.load_map, frames.camera, reuse);
   reuse.localize_only = args.localize_only;
   reuse.save = args.save_map;
-  const SlamRunResult result = RunSlamOnDataset(dataset, args.dataset, options, markers,
-                                                args.out, !args.quiet, std::move(reuse));
+  const SlamRunResult result = RunSlamOnFrames(frames, args.dataset, options, markers,
+                                               args.out, !args.quiet, std::move(reuse));
   std::printf("%s\n", SlamRunSummary(result, args.out).c_str());
   if (!args.save_map.empty()) {
     std::printf("map saved to %s (%d keyframes, %d points)\n", args.save_map.c_str(),
@@ -113,13 +129,19 @@ void AddRunCommand(CLI::App& app, int& exit_status) {
       "run", "SLAM on a sequence -> trajectory.tum, keyframes.tum, map.ply, stats.json "
              "(+ markers.json with a marker map)");
   run->add_option("--dataset", args->dataset,
-                  "the sequence: EuRoC layout (mav0/cam0), TUM RGB-D folder or image folder")
+                  "the sequence: EuRoC layout (mav0/cam0), TUM RGB-D folder, image folder or "
+                  "ROS 1 bag (FILE.bag, with --image-topic)")
       ->required();
+  run->add_option("--image-topic", args->image_topic,
+                  "ROS bag: the image topic (sensor_msgs/Image or CompressedImage)");
+  run->add_option("--camera-info-topic", args->camera_info_topic,
+                  "ROS bag: the sensor_msgs/CameraInfo topic (default: the image topic's "
+                  "namespace + /camera_info; --camera replaces it)");
   run->add_option("--out", args->out, "output folder (replaced only when the run succeeds)")
       ->required();
   run->add_option("--camera", args->camera,
                   "calibration file (EuRoC sensor.yaml, ORB-SLAM3 settings or ROS camera_info); "
-                  "required for TUM and image folders");
+                  "required for TUM and image folders, and for bags without camera_info");
   run->add_flag("--no-markers", args->no_markers,
                 "ignore the sequence's markers.json (keypoints only). Without this flag a "
                 "markers.json in the sequence puts the run in the marker world frame, with "

@@ -20,12 +20,12 @@ Trajectory ToTrajectory(const std::vector<StampedPose>& poses) {
   return trajectory;
 }
 
-SlamRunStats MakeStats(const std::string& dataset_label, const Dataset& dataset,
+SlamRunStats MakeStats(const std::string& dataset_label, const std::string& layout,
                        const System& system, bool blocking, bool markers, double wall_time_s) {
   const SystemStats stats = system.Stats();
   SlamRunStats out;
   out.dataset = dataset_label;
-  out.layout = DatasetLayoutName(dataset.layout());
+  out.layout = layout;
   out.blocking = blocking;
   out.markers = markers;
   out.frames = stats.num_frames;
@@ -108,23 +108,40 @@ SystemOptions DefaultRunOptions(bool blocking, std::shared_ptr<const Vocabulary>
   return options;
 }
 
+FrameFeed DatasetFeed(const Dataset& dataset) {
+  FrameFeed frames;
+  frames.layout = DatasetLayoutName(dataset.layout());
+  frames.camera = dataset.camera();
+  frames.size = dataset.size();
+  frames.timestamp_s = [&dataset](std::size_t i) { return dataset.frame(i).timestamp_s; };
+  frames.load_image = [&dataset](std::size_t i) { return dataset.LoadImage(i); };
+  return frames;
+}
+
 SlamRunResult RunSlamOnDataset(const Dataset& dataset, const std::string& dataset_label,
                                const SystemOptions& options, bool markers,
                                const std::filesystem::path& out_dir, bool progress,
                                MapReuse reuse) {
+  return RunSlamOnFrames(DatasetFeed(dataset), dataset_label, options, markers, out_dir,
+                         progress, std::move(reuse));
+}
+
+SlamRunResult RunSlamOnFrames(const FrameFeed& frames, const std::string& dataset_label,
+                              const SystemOptions& options, bool markers,
+                              const std::filesystem::path& out_dir, bool progress,
+                              MapReuse reuse) {
   StagedDirectory staged(out_dir);
   const Stopwatch wall;
-  System system(dataset.camera(), options);
+  System system(frames.camera, options);
   if (reuse.loaded) {
     system.StartFromMap(std::move(*reuse.loaded), reuse.loaded_info.world_aligned,
                         reuse.localize_only);
   }
-  for (std::size_t i = 0; i < dataset.size(); ++i) {
-    const FrameReport report =
-        system.ProcessImage(dataset.LoadImage(i), dataset.frame(i).timestamp_s);
-    if (progress && (i % 10 == 0 || i + 1 == dataset.size())) {
+  for (std::size_t i = 0; i < frames.size; ++i) {
+    const FrameReport report = system.ProcessImage(frames.load_image(i), frames.timestamp_s(i));
+    if (progress && (i % 10 == 0 || i + 1 == frames.size)) {
       std::fprintf(stderr, "\rframe %zu/%zu  %-15s keyframes %zu  points %zu", i + 1,
-                   dataset.size(), TrackingStateName(report.state).c_str(),
+                   frames.size, TrackingStateName(report.state).c_str(),
                    system.map().NumKeyframes(), system.map().NumMapPoints());
       std::fflush(stderr);
     }
@@ -133,7 +150,7 @@ SlamRunResult RunSlamOnDataset(const Dataset& dataset, const std::string& datase
   if (progress) std::fprintf(stderr, "\n");
   SlamRunResult result;
   result.stats =
-      MakeStats(dataset_label, dataset, system, options.blocking, markers, wall.ElapsedSeconds());
+      MakeStats(dataset_label, frames.layout, system, options.blocking, markers, wall.ElapsedSeconds());
   result.trajectory = ToTrajectory(system.Trajectory());
   result.keyframes = ToTrajectory(system.KeyframePoses());
   result.timing = system.Stats();

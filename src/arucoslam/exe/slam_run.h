@@ -5,6 +5,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -44,8 +45,25 @@ struct SlamRunResult {
 SystemOptions DefaultRunOptions(bool blocking, std::shared_ptr<const Vocabulary> vocabulary,
                                 bool loop_closing);
 
+// The frames a run reads, from a Dataset or another source (a ROS 1 bag, exe/bag_feed.h).
+struct FrameFeed {
+  std::string layout;  // stats.json's "layout"
+  CameraModel camera;
+  std::size_t size = 0;
+  std::function<double(std::size_t)> timestamp_s;   // increasing
+  std::function<cv::Mat(std::size_t)> load_image;  // 8-bit grey; may throw InputError
+};
+
+// The frames of `dataset`, which must outlive the feed.
+FrameFeed DatasetFeed(const Dataset& dataset);
+
 // `dataset_label` names the dataset in stats.json; `markers` says whether the run used the
 // sequence's marker map. A progress line goes to stderr when `progress` is set.
+SlamRunResult RunSlamOnFrames(const FrameFeed& frames, const std::string& dataset_label,
+                              const SystemOptions& options, bool markers,
+                              const std::filesystem::path& out_dir, bool progress,
+                              MapReuse reuse = {});
+// RunSlamOnFrames on DatasetFeed(dataset).
 SlamRunResult RunSlamOnDataset(const Dataset& dataset, const std::string& dataset_label,
                                const SystemOptions& options, bool markers,
                                const std::filesystem::path& out_dir, bool progress,
