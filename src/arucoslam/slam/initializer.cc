@@ -4,6 +4,7 @@
 
 #include <Eigen/SVD>
 #include <algorithm>
+#include <functional>
 #include <cmath>
 #include <stdexcept>
 
@@ -26,6 +27,7 @@ struct MotionEvaluation {
   std::vector<int> usable;  // match positions giving good, finite map points
   std::vector<Eigen::Vector3d> points;  // one per usable, in camera 1
   std::vector<double> parallaxes_rad;   // of every consistent point
+  int epipolar_support = 0;  // matches within the Sampson gate of the (refined) motion
 };
 
 MotionEvaluation EvaluateMotion(const Rigid3& cam2_from_cam1,
@@ -105,7 +107,9 @@ bool InitializerOptions::Check() const {
          homography_share > 0.0 && homography_share < 1.0 && min_median_flow_px >= 0.0 &&
          min_translation_flow_px >= 0.0 && min_parallax_deg >= 0.0 && max_reprojection_px > 0.0 &&
          min_triangulated >= 1 && min_triangulated_fraction >= 0.0 &&
-         min_triangulated_fraction <= 1.0 && ambiguity_ratio > 0.0 && ambiguity_ratio < 1.0;
+         min_triangulated_fraction <= 1.0 && ambiguity_ratio > 0.0 && ambiguity_ratio < 1.0 &&
+         min_epipolar_support_ratio >= 0.0 && min_epipolar_support_ratio <= 1.0 &&
+         min_axis_agreement_cos >= 0.0 && min_axis_agreement_cos <= 1.0;
 }
 
 std::string InitFailureName(InitFailure failure) {
@@ -184,7 +188,9 @@ Rigid3 RefineWithSampsonGate(const Rigid3& motion, const std::vector<Eigen::Vect
 // Tests every motion of the chosen model by triangulation and keeps the best if it is
 // unambiguous, well supported and has enough parallax; scales it to median depth 1.
 InitializationResult ChooseMotion(const InitializerOptions& options, InitializationResult result,
-                                  const TwoViewModel& model, const std::vector<Eigen::Vector2d>& n1,
+                                  const TwoViewModel& model, const std::vector<bool>& judged,
+                                  const std::vector<bool>& off_plane,
+                                  const std::vector<Eigen::Vector2d>& n1,
                                   const std::vector<Eigen::Vector2d>& n2,
                                   const std::vector<FeatureMatch>& matches,
                                   const CameraModel& camera, const Eigen::Matrix3d& k) {
@@ -194,31 +200,81 @@ InitializationResult ChooseMotion(const InitializerOptions& options, Initializat
     return Fail(std::move(result), InitFailure::kPureRotation,
                 "homography has no translation solution");
   }
-  int best = -1, second_consistent = 0;
+  // Each candidate that explains points is sharpened by a few Sampson iterations (the linear
+  // model is biased by noise; kept unless it then explains clearly fewer points). The
+  // candidates that agree best with the epipolar geometry of all matches then compete on the
+  // points they place in front of both cameras. Compared on that count alone, a car's true
+  // forward motion lost to the road plane's twin solution (translation along the plane's
+  // normal): its epipole lies in the image, where noise flips the depth of many points, yet
+  // the points off the plane follow its epipolar lines and not the twin's.
+  std::vector<Rigid3> motions = candidates;
   std::vector<MotionEvaluation> evaluations;
-  for (const Rigid3& motion : candidates) {
+  int max_support = 0;
+  for (Rigid3& motion : motions) {
     evaluations.push_back(
-        EvaluateMotion(motion, n1, n2, model.inliers, camera, options.max_reprojection_px));
-    const int index = static_cast<int>(evaluations.size()) - 1;
-    if (best < 0 || evaluations[index].consistent > evaluations[best].consistent) {
-      if (best >= 0) second_consistent = evaluations[best].consistent;
-      best = index;
+        EvaluateMotion(motion, n1, n2, judged, camera, options.max_reprojection_px));
+    if (evaluations.back().consistent == 0) continue;
+    std::vector<bool> refined_inliers;
+    const Rigid3 refined = RefineWithSampsonGate(motion, n1, n2, model.inliers, camera,
+                                                 options.sigma_px, &refined_inliers);
+    MotionEvaluation refined_evaluation =
+        EvaluateMotion(refined, n1, n2, refined_inliers, camera, options.max_reprojection_px);
+    for (std::size_t i = 0; i < off_plane.size(); ++i) {
+      if (off_plane[i] && refined_inliers[i]) ++refined_evaluation.epipolar_support;
+    }
+    if (refined_evaluation.consistent >= 0.95 * evaluations.back().consistent) {
+      motion = refined;
+      evaluations.back() = std::move(refined_evaluation);
     } else {
-      second_consistent = std::max(second_consistent, evaluations[index].consistent);
+      evaluations.back().epipolar_support = refined_evaluation.epipolar_support;
+    }
+    max_support = std::max(max_support, evaluations.back().epipolar_support);
+  }
+  // With enough matches off the homography's plane, the candidate that best explains their
+  // epipolar geometry sets the translation axis. Another candidate about as well supported
+  // along a different axis (the plane's twin while the baseline is short) makes the pair
+  // ambiguous: later frames will tell them apart. A plane alone cannot: there cheirality
+  // decides, as for the fundamental model's four motions.
+  const bool judge_axis =
+      std::count(off_plane.begin(), off_plane.end(), true) >= options.min_triangulated;
+  int best_supported = -1;
+  for (std::size_t c = 0; c < evaluations.size(); ++c) {
+    if (evaluations[c].consistent == 0) continue;
+    if (best_supported < 0 ||
+        evaluations[c].epipolar_support > evaluations[best_supported].epipolar_support) {
+      best_supported = static_cast<int>(c);
     }
   }
-  // The linear model is biased by noise; a few Sampson iterations on the inliers sharpen
-  // the motion, kept unless it explains clearly fewer points.
-  Rigid3 motion = candidates[best];
-  std::vector<bool> refined_inliers;
-  const Rigid3 refined = RefineWithSampsonGate(motion, n1, n2, model.inliers, camera,
-                                               options.sigma_px, &refined_inliers);
-  MotionEvaluation refined_evaluation =
-      EvaluateMotion(refined, n1, n2, refined_inliers, camera, options.max_reprojection_px);
-  if (refined_evaluation.consistent >= 0.95 * evaluations[best].consistent) {
-    motion = refined;
-    evaluations[best] = std::move(refined_evaluation);
+  if (best_supported < 0) {
+    return Fail(std::move(result), InitFailure::kTooFewTriangulated,
+                "no motion places points in front of both cameras");
   }
+  const Eigen::Vector3d axis = motions[best_supported].translation.normalized();
+  int best = -1;
+  int second_consistent = 0;
+  for (std::size_t c = 0; c < evaluations.size(); ++c) {
+    const MotionEvaluation& evaluation = evaluations[c];
+    if (evaluation.consistent == 0) continue;
+    if (judge_axis &&
+        evaluation.epipolar_support < options.min_epipolar_support_ratio * max_support) {
+      continue;
+    }
+    if (judge_axis &&
+        std::abs(motions[c].translation.normalized().dot(axis)) < options.min_axis_agreement_cos) {
+      return Fail(std::move(result), InitFailure::kAmbiguous,
+                  fmt::format("two translation axes fit the epipolar geometry ({} and {} "
+                              "matches)",
+                              evaluations[best_supported].epipolar_support,
+                              evaluation.epipolar_support));
+    }
+    if (best < 0 || evaluation.consistent > evaluations[best].consistent) {
+      if (best >= 0) second_consistent = evaluations[best].consistent;
+      best = static_cast<int>(c);
+    } else {
+      second_consistent = std::max(second_consistent, evaluation.consistent);
+    }
+  }
+  const Rigid3 motion = motions[best];
   MotionEvaluation& chosen = evaluations[best];
   std::vector<double> parallaxes_deg;
   for (double p : chosen.parallaxes_rad) parallaxes_deg.push_back(p * kDegPerRad);
@@ -236,7 +292,15 @@ InitializationResult ChooseMotion(const InitializerOptions& options, Initializat
   if (chosen.consistent < needed) {
     return Fail(std::move(result), InitFailure::kTooFewTriangulated, summary);
   }
-  if (result.median_parallax_deg < options.min_parallax_deg) {
+  // The parallax of the min_triangulated-th widest point: far points (a street ahead of a car)
+  // keep the median near zero however wide the baseline, while the nearer points that hold
+  // the map's geometry already see it from well-separated views.
+  std::vector<double> widest_first = parallaxes_deg;
+  std::sort(widest_first.begin(), widest_first.end(), std::greater<double>());
+  const std::size_t rank = static_cast<std::size_t>(options.min_triangulated) - 1;
+  const double parallax_deg =
+      widest_first.empty() ? 0.0 : widest_first[std::min(rank, widest_first.size() - 1)];
+  if (parallax_deg < options.min_parallax_deg) {
     return Fail(std::move(result), InitFailure::kTooLittleParallax, summary);
   }
   if (static_cast<int>(chosen.usable.size()) < options.min_triangulated) {
@@ -313,7 +377,19 @@ InitializationResult Initializer::InitializeFromMatches(
                 fmt::format("median flow {:.2f} px, {:.2f} px after removing the rotation",
                             result.median_flow_px, derotated));
   }
-  return ChooseMotion(options_, std::move(result), chosen, n1, n2, matches, camera, k);
+  // The candidate motions are judged on every match either model explains; the matches of
+  // the fundamental model off the homography's plane tell a plane's two motions apart.
+  std::vector<bool> judged = chosen.inliers;
+  std::vector<bool> off_plane(judged.size(), false);
+  if (use_h && fundamental.valid) {
+    for (std::size_t i = 0; i < judged.size(); ++i) {
+      off_plane[i] = fundamental.inliers[i] && !homography.inliers[i];
+      judged[i] = judged[i] || fundamental.inliers[i];
+    }
+  }
+  return ChooseMotion(options_, std::move(result), chosen, judged, off_plane, n1, n2, matches,
+                      camera, k);
 }
 
 }  // namespace arucoslam
+

@@ -27,7 +27,8 @@ struct InitializerOptions {
   // Median displacement left after removing the best rotation (pixels) below which the
   // motion is taken as a pure rotation.
   double min_translation_flow_px = 2.0;
-  double min_parallax_deg = 1.0;           // median parallax of the triangulated points
+  // Parallax (degrees) that the min_triangulated-th widest consistent point must reach.
+  double min_parallax_deg = 1.0;
   double max_reprojection_px = 2.0;        // per view, for a triangulated point to count
   int min_triangulated = 50;               // absolute minimum of good points
   double min_triangulated_fraction = 0.9;  // of the chosen model's inliers
@@ -36,6 +37,12 @@ struct InitializerOptions {
   // second physical solution of the plane typically keeps 70-80% of the points in front of
   // both cameras, so 0.8 asks that at least a fifth of the points rule it out.
   double ambiguity_ratio = 0.8;
+  // Candidate motions whose epipolar support (matches within the Sampson gate of the refined
+  // motion) is below this fraction of the best candidate's are not considered. Those above it
+  // must share the best one's translation axis (|cos| of the angle at least
+  // min_axis_agreement_cos, about 30 degrees), else the pair is ambiguous.
+  double min_epipolar_support_ratio = 0.9;
+  double min_axis_agreement_cos = 0.866;
 
   bool Check() const;
 };

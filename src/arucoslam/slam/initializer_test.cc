@@ -358,5 +358,79 @@ TEST(Initializer, EurocStaticCameraNeverInitialises) {
   }
 }
 
+// A car on a street (KITTI-like camera 1.65 m above the road): most points on the road plane,
+// the rest on house fronts and far down the street, the camera moving forward while turning.
+// The road's homography has a twin solution that moves the camera along the road's normal;
+// it places more points in front of both cameras than the true motion (whose epipole lies in
+// the image), but the points off the road rule it out.
+SyntheticPair MakeStreetPair(const Rigid3& cam2_from_cam1, std::uint32_t seed) {
+  CameraModel camera = PinholeCamera();
+  camera.width = 1226;
+  camera.height = 370;
+  camera.fx = camera.fy = 707.0912;
+  camera.cx = 601.8873;
+  camera.cy = 183.1104;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> noise(0.0, 0.8 / camera.fx);
+  SyntheticPair pair;
+  while (pair.points_in_cam1.size() < 400) {
+    Eigen::Vector3d p;
+    const double kind = unit(rng);
+    if (kind < 0.6) {  // road
+      p = Eigen::Vector3d(-8.0 + 16.0 * unit(rng), 1.65, 4.0 + 20.0 * unit(rng));
+    } else if (kind < 0.9) {  // house fronts on both sides
+      p = Eigen::Vector3d(unit(rng) < 0.5 ? -7.0 : 7.0, -6.0 + 7.5 * unit(rng),
+                          5.0 + 35.0 * unit(rng));
+    } else {  // far down the street
+      p = Eigen::Vector3d(-6.0 + 12.0 * unit(rng), -4.0 + 5.0 * unit(rng),
+                          40.0 + 40.0 * unit(rng));
+    }
+    const Eigen::Vector3d q = cam2_from_cam1 * p;
+    const auto a = camera.Project(p), b = camera.Project(q);
+    if (!a || !b || !camera.InImage(*a) || !camera.InImage(*b)) continue;
+    pair.points_in_cam1.push_back(p);
+    pair.normalised1.push_back(p.hnormalized() + Eigen::Vector2d(noise(rng), noise(rng)));
+    pair.normalised2.push_back(q.hnormalized() + Eigen::Vector2d(noise(rng), noise(rng)));
+  }
+  for (int i = 0; i < 400; ++i) pair.matches.push_back({i, i, 0});
+  return pair;
+}
+
+TEST(Initializer, StreetSceneNeverTakesTheRoadPlanesTwinMotion) {
+  CameraModel camera = PinholeCamera();
+  camera.width = 1226;
+  camera.height = 370;
+  camera.fx = camera.fy = 707.0912;
+  camera.cx = 601.8873;
+  camera.cy = 183.1104;
+  const Initializer initializer;
+  int successes = 0;
+  for (const double forward_m : {0.2, 0.3, 0.5, 1.0}) {
+    for (std::uint32_t seed = 1; seed <= 5; ++seed) {
+      // cam2_from_cam1 of a camera that moved forward (+z) and turned left by 0.8 degrees.
+      const Rigid3 cam1_from_cam2(
+          Eigen::Quaterniond(Eigen::AngleAxisd(-0.8 * M_PI / 180.0, Eigen::Vector3d::UnitY())),
+          Eigen::Vector3d(0.0, 0.0, forward_m));
+      const Rigid3 cam2_from_cam1 = cam1_from_cam2.Inverse();
+      const SyntheticPair pair = MakeStreetPair(cam2_from_cam1, seed);
+      const InitializationResult result = initializer.InitializeFromMatches(
+          pair.normalised1, pair.normalised2, pair.matches, camera);
+      if (!result.success) continue;
+      ++successes;
+      const Eigen::Vector3d moved = -(result.cam2_from_cam1.rotation.conjugate() *
+                                      result.cam2_from_cam1.translation);
+      const double direction_error_deg =
+          std::acos(std::clamp(moved.normalized().z(), -1.0, 1.0)) * 180.0 / M_PI;
+      const double rotation_error_deg =
+          result.cam2_from_cam1.rotation.angularDistance(cam2_from_cam1.rotation) * 180.0 / M_PI;
+      EXPECT_LT(direction_error_deg, 10.0) << forward_m << " m, seed " << seed;
+      EXPECT_LT(rotation_error_deg, 0.3) << forward_m << " m, seed " << seed;
+    }
+  }
+  // With a metre of baseline the street initialises.
+  EXPECT_GE(successes, 5);
+}
+
 }  // namespace
 }  // namespace arucoslam
