@@ -60,7 +60,7 @@ TEST(CalibrationTest, ReadsTheRealEuRoCSensorYaml) {
   EXPECT_EQ(camera.cx, 367.215);
   EXPECT_EQ(camera.cy, 248.375);
   EXPECT_EQ(camera.model, DistortionModel::kRadTan);
-  const std::array<double, 5> expected = {-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05, 0.0};
+  const std::array<double, kMaxDistortionCoefficients> expected = {-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05, 0.0};
   EXPECT_EQ(camera.distortion, expected);
   EXPECT_EQ(camera.rate_hz, 20.0);
   EXPECT_TRUE(camera.Check());
@@ -86,7 +86,7 @@ TEST(CalibrationTest, ReadsTheRealFlatRosCameraInfoFiles) {
   EXPECT_EQ(camera.cx, 655.863924415);
   EXPECT_EQ(camera.cy, 490.614022124);
   EXPECT_EQ(camera.model, DistortionModel::kRadTan);
-  const std::array<double, 5> expected = {0.134973508728, -0.233586982745, 0.000669703031508,
+  const std::array<double, kMaxDistortionCoefficients> expected = {0.134973508728, -0.233586982745, 0.000669703031508,
                                           0.00484673746587, 0.0};
   EXPECT_EQ(camera.distortion, expected);
 
