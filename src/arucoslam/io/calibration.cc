@@ -394,6 +394,13 @@ CameraCalibration ParseOrbSlam3(const FieldReader& fields) {
   return calibration;
 }
 
+// image_width and image_height (ROS camera_info, OpenCV FileStorage).
+void ReadImageSize(const FieldReader& fields, CameraModel* camera) {
+  camera->width = fields.Integer({"image_width"});
+  camera->height = fields.Integer({"image_height"});
+  RequirePositiveSize(fields, {"image_width"}, camera->width, camera->height);
+}
+
 // A 3x3 camera matrix as 9 numbers, row major, without skew.
 void ReadCameraMatrix(const FieldReader& fields, const FieldPath& path, CameraModel* camera) {
   const std::vector<double> k = fields.Numbers(path, 9, 9);
@@ -423,9 +430,7 @@ CameraCalibration ParseRosCameraInfo(const FieldReader& fields) {
   CameraCalibration calibration;
   calibration.format = CalibrationFormat::kRosCameraInfo;
   CameraModel& camera = calibration.camera;
-  camera.width = fields.Integer({"image_width"});
-  camera.height = fields.Integer({"image_height"});
-  RequirePositiveSize(fields, {"image_width"}, camera.width, camera.height);
+  ReadImageSize(fields, &camera);
   if (fields.Has({"camera_model"}) && fields.Text({"camera_model"}) != "pinhole") {
     fields.Fail({"camera_model"}, fmt::format("unsupported model '{}' (expected pinhole)",
                                               fields.Text({"camera_model"})));
@@ -458,9 +463,7 @@ CameraCalibration ParseOpenCvStorage(const FieldReader& fields) {
   CameraCalibration calibration;
   calibration.format = CalibrationFormat::kOpenCv;
   CameraModel& camera = calibration.camera;
-  camera.width = fields.Integer({"image_width"});
-  camera.height = fields.Integer({"image_height"});
-  RequirePositiveSize(fields, {"image_width"}, camera.width, camera.height);
+  ReadImageSize(fields, &camera);
   if (fields.Integer({"camera_matrix", "rows"}) != 3 ||
       fields.Integer({"camera_matrix", "cols"}) != 3) {
     fields.Fail({"camera_matrix"}, "expected a 3x3 matrix");

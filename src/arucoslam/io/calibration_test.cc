@@ -48,24 +48,33 @@ fs::path WriteFile(const std::string& name, const std::string& text) {
     GTEST_SKIP() << "test data missing: " << (kDataDir / (relative)).string(); \
   }
 
-TEST(CalibrationTest, ReadsTheRealEuRoCSensorYaml) {
-  REQUIRE_DATA("euroc_v101_micro/mav0/cam0/sensor.yaml");
-  const CameraCalibration calibration =
-      ReadCameraCalibration(kDataDir / "euroc_v101_micro/mav0/cam0/sensor.yaml");
-  const CameraModel& camera = calibration.camera;
-  EXPECT_EQ(calibration.format, CalibrationFormat::kEuRoC);
+// EuRoC MAV cam0 (V1_01 sensor.yaml), which several of the files below describe.
+void ExpectEurocCam0Intrinsics(const CameraModel& camera) {
   EXPECT_EQ(camera.width, 752);
   EXPECT_EQ(camera.height, 480);
   EXPECT_EQ(camera.fx, 458.654);
   EXPECT_EQ(camera.fy, 457.296);
   EXPECT_EQ(camera.cx, 367.215);
   EXPECT_EQ(camera.cy, 248.375);
+}
+
+void ExpectEurocCam0(const CameraModel& camera) {
+  ExpectEurocCam0Intrinsics(camera);
   EXPECT_EQ(camera.model, DistortionModel::kRadTan);
   const std::array<double, kMaxDistortionCoefficients> expected = {-0.28340811, 0.07395907,
                                                                    0.00019359, 1.76187114e-05, 0.0};
   EXPECT_EQ(camera.distortion, expected);
-  EXPECT_EQ(camera.rate_hz, 20.0);
   EXPECT_TRUE(camera.Check());
+}
+
+TEST(CalibrationTest, ReadsTheRealEuRoCSensorYaml) {
+  REQUIRE_DATA("euroc_v101_micro/mav0/cam0/sensor.yaml");
+  const CameraCalibration calibration =
+      ReadCameraCalibration(kDataDir / "euroc_v101_micro/mav0/cam0/sensor.yaml");
+  const CameraModel& camera = calibration.camera;
+  EXPECT_EQ(calibration.format, CalibrationFormat::kEuRoC);
+  ExpectEurocCam0(camera);
+  EXPECT_EQ(camera.rate_hz, 20.0);
   // T_BS: body_from_cam, first row 0.0148655429818, -0.999880929698, 0.00414029679422.
   EXPECT_TRUE(calibration.body_from_cam.translation.isApprox(
       Eigen::Vector3d(-0.0216401454975, -0.064676986768, 0.00981073058949), 1e-12));
@@ -184,12 +193,7 @@ TEST(CalibrationTest, ReadsOpenCvFileStorageYamlAndXml) {
       SCOPED_TRACE(path.string());
       EXPECT_EQ(calibration.format, CalibrationFormat::kOpenCv);
       const CameraModel& camera = calibration.camera;
-      EXPECT_EQ(camera.width, 752);
-      EXPECT_EQ(camera.height, 480);
-      EXPECT_EQ(camera.fx, 458.654);
-      EXPECT_EQ(camera.fy, 457.296);
-      EXPECT_EQ(camera.cx, 367.215);
-      EXPECT_EQ(camera.cy, 248.375);
+      ExpectEurocCam0Intrinsics(camera);
       const DistortionModel expected_model = count == 0    ? DistortionModel::kNone
                                              : count <= 5  ? DistortionModel::kRadTan
                                              : count == 8  ? DistortionModel::kRational
@@ -225,14 +229,7 @@ cam1:
 )");
   const CameraCalibration calibration = ReadCameraCalibration(path);
   EXPECT_EQ(calibration.format, CalibrationFormat::kKalibr);
-  const CameraModel& camera = calibration.camera;
-  EXPECT_EQ(camera.width, 752);
-  EXPECT_EQ(camera.height, 480);
-  EXPECT_EQ(camera.fx, 458.654);
-  EXPECT_EQ(camera.cy, 248.375);
-  EXPECT_EQ(camera.model, DistortionModel::kRadTan);
-  EXPECT_EQ(camera.distortion[3], 1.76187114e-05);
-  EXPECT_EQ(camera.distortion[4], 0.0);
+  ExpectEurocCam0(calibration.camera);
   // body (IMU) from camera is the inverse of T_cam_imu: EuRoC's T_BS.
   EXPECT_TRUE(calibration.body_from_cam.translation.isApprox(
       Eigen::Vector3d(-0.0216401454975, -0.064676986768, 0.00981073058949), 1e-6));
@@ -272,14 +269,8 @@ ORBextractor.nFeatures: 1000
 )");
   const CameraCalibration calibration = ReadCameraCalibration(path);
   EXPECT_EQ(calibration.format, CalibrationFormat::kOrbSlam3);
-  const CameraModel& camera = calibration.camera;
-  EXPECT_EQ(camera.fx, 458.654);
-  EXPECT_EQ(camera.cy, 248.375);
-  EXPECT_EQ(camera.width, 752);
-  EXPECT_EQ(camera.rate_hz, 20.0);
-  EXPECT_EQ(camera.model, DistortionModel::kRadTan);
-  EXPECT_EQ(camera.distortion[3], 1.76187114e-05);
-  EXPECT_EQ(camera.distortion[4], 0.0);
+  ExpectEurocCam0(calibration.camera);
+  EXPECT_EQ(calibration.camera.rate_hz, 20.0);
 }
 
 // The File.version "1.0" layout with a fisheye and an IMU extrinsic (!!opencv-matrix).

@@ -6,6 +6,7 @@
 #include <charconv>
 #include <utility>
 
+#include "arucoslam/markers/preprocess.h"
 #include "arucoslam/pipeline/bounded_queue.h"
 #include "arucoslam/util/error.h"
 
@@ -46,7 +47,7 @@ CameraSource::CameraSource(const std::string& device, const CameraModel& camera,
     throw InputError(device, "the camera delivered no frame");
   }
   start_ = std::chrono::steady_clock::now();
-  first = ToGrey8(first);
+  first = Preprocess(first);  // 8-bit grey: colour converted, 16-bit scaled
   if (first.cols != camera.width || first.rows != camera.height) {
     throw InputError(device, fmt::format("frames are {}x{} but the camera calibration says {}x{}",
                                          first.cols, first.rows, camera.width, camera.height));
@@ -77,7 +78,7 @@ void CameraSource::Capture() {
                  last_timestamp_s + 1e-6);
     last_timestamp_s = timestamp_s;
     ++captured_;
-    cv::Mat grey = ToGrey8(frame);
+    cv::Mat grey = Preprocess(frame);
     if (grey.cols != camera_.width || grey.rows != camera_.height ||
         !queue_->frames.TryPush(SourceFrame{0, timestamp_s, std::move(grey)})) {
       ++dropped_;

@@ -1,29 +1,11 @@
 #include "arucoslam/io/frame_source.h"
 
-#include <opencv2/imgproc.hpp>
-
 #include "arucoslam/io/calibration.h"
 #include "arucoslam/io/video_source.h"
 #include "arucoslam/util/error.h"
 #include "arucoslam/util/files.h"
 
 namespace arucoslam {
-
-// An 8-bit grey copy of a decoded frame (OpenCV decodes to BGR or BGRA, some codecs to grey).
-cv::Mat ToGrey8(const cv::Mat& frame) {
-  cv::Mat grey;
-  if (frame.channels() == 3) {
-    cv::cvtColor(frame, grey, cv::COLOR_BGR2GRAY);
-  } else if (frame.channels() == 4) {
-    cv::cvtColor(frame, grey, cv::COLOR_BGRA2GRAY);
-  } else {
-    grey = frame.clone();
-  }
-  if (grey.depth() != CV_8U) {
-    grey.convertTo(grey, CV_8U, grey.depth() == CV_16U ? 1.0 / 256.0 : 1.0);
-  }
-  return grey;
-}
 
 std::optional<SourceFrame> DatasetSource::Next() {
   if (next_ >= dataset_.size()) return std::nullopt;

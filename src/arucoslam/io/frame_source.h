@@ -43,9 +43,6 @@ class FrameSource {
   virtual std::size_t frames_dropped() const { return 0; }
 };
 
-// An 8-bit grey copy of a decoded video or camera frame (BGR, BGRA or grey; 16-bit scaled).
-cv::Mat ToGrey8(const cv::Mat& frame);
-
 // A Dataset as a FrameSource (images loaded one at a time, as Next() asks).
 class DatasetSource : public FrameSource {
  public:

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "arucoslam/markers/preprocess.h"
 #include "arucoslam/util/error.h"
 #include "arucoslam/util/files.h"
 
@@ -47,7 +48,7 @@ void VideoSource::Decode() {
       out.timestamp_s = last_timestamp_s_ + container_period_s_;
     }
   }
-  out.image = ToGrey8(frame);
+  out.image = Preprocess(frame);  // 8-bit grey: colour converted, 16-bit scaled
   if (out.image.cols != camera_.width || out.image.rows != camera_.height) {
     throw InputError(
         path_.string(),
