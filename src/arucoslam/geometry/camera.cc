@@ -27,30 +27,35 @@ using Coefficients = std::array<double, kMaxDistortionCoefficients>;
 // OpenCV's pinhole distortion before the sensor tilt, of normalised coordinates, and its 2x2
 // Jacobian: radial (1 + k1 r^2 + k2 r^4 + k3 r^6) / (1 + k4 r^2 + k5 r^4 + k6 r^6),
 // tangential p1 p2, thin prism s1..s4. Coefficients a model lacks are zero, so this is the
-// radial-tangential, rational and thin-prism models alike.
+// radial-tangential, rational and thin-prism models alike; kRadTanOnly leaves out the
+// denominator and the prism terms (the radial-tangential model, which SLAM calls most).
+template <bool kRadTanOnly>
 Eigen::Vector2d DistortRational(const Coefficients& d, const Eigen::Vector2d& p,
                                 Matrix2d* jacobian) {
-  const double k1 = d[0], k2 = d[1], p1 = d[2], p2 = d[3], k3 = d[4], k4 = d[5], k5 = d[6],
-               k6 = d[7], s1 = d[8], s2 = d[9], s3 = d[10], s4 = d[11];
+  const double k1 = d[0], k2 = d[1], p1 = d[2], p2 = d[3], k3 = d[4];
   const double x = p.x(), y = p.y();
   const double r2 = x * x + y * y;
-  const double numerator = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
-  const double denominator = 1.0 + r2 * (k4 + r2 * (k5 + r2 * k6));
-  const double radial = numerator / denominator;
+  double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  double radial_d_r2 = k1 + r2 * (2.0 * k2 + 3.0 * k3 * r2);
+  Eigen::Vector2d prism = Eigen::Vector2d::Zero(), prism_d_r2 = Eigen::Vector2d::Zero();
+  if constexpr (!kRadTanOnly) {
+    const double k4 = d[5], k5 = d[6], k6 = d[7], s1 = d[8], s2 = d[9], s3 = d[10], s4 = d[11];
+    const double denominator = 1.0 + r2 * (k4 + r2 * (k5 + r2 * k6));
+    radial /= denominator;
+    radial_d_r2 = (radial_d_r2 - radial * (k4 + r2 * (2.0 * k5 + 3.0 * k6 * r2))) / denominator;
+    prism = r2 * Eigen::Vector2d(s1 + s2 * r2, s3 + s4 * r2);
+    prism_d_r2 = Eigen::Vector2d(s1 + 2.0 * s2 * r2, s3 + 2.0 * s4 * r2);
+  }
   const Eigen::Vector2d distorted(
-      x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x) + r2 * (s1 + s2 * r2),
-      y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y + r2 * (s3 + s4 * r2));
+      x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x) + prism.x(),
+      y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y + prism.y());
   if (jacobian != nullptr) {
-    const double numerator_d_r2 = k1 + r2 * (2.0 * k2 + 3.0 * k3 * r2);
-    const double denominator_d_r2 = k4 + r2 * (2.0 * k5 + 3.0 * k6 * r2);
-    const double radial_d_r2 = (numerator_d_r2 - radial * denominator_d_r2) / denominator;
-    const double prism_x_d_r2 = s1 + 2.0 * s2 * r2, prism_y_d_r2 = s3 + 2.0 * s4 * r2;
     (*jacobian)(0, 0) =
-        radial + 2.0 * x * (x * radial_d_r2 + prism_x_d_r2) + 2.0 * p1 * y + 6.0 * p2 * x;
-    (*jacobian)(0, 1) = 2.0 * y * (x * radial_d_r2 + prism_x_d_r2) + 2.0 * p1 * x + 2.0 * p2 * y;
-    (*jacobian)(1, 0) = 2.0 * x * (y * radial_d_r2 + prism_y_d_r2) + 2.0 * p1 * x + 2.0 * p2 * y;
+        radial + 2.0 * x * (x * radial_d_r2 + prism_d_r2.x()) + 2.0 * p1 * y + 6.0 * p2 * x;
+    (*jacobian)(0, 1) = 2.0 * y * (x * radial_d_r2 + prism_d_r2.x()) + 2.0 * p1 * x + 2.0 * p2 * y;
+    (*jacobian)(1, 0) = 2.0 * x * (y * radial_d_r2 + prism_d_r2.y()) + 2.0 * p1 * x + 2.0 * p2 * y;
     (*jacobian)(1, 1) =
-        radial + 2.0 * y * (y * radial_d_r2 + prism_y_d_r2) + 6.0 * p1 * y + 2.0 * p2 * x;
+        radial + 2.0 * y * (y * radial_d_r2 + prism_d_r2.y()) + 6.0 * p1 * y + 2.0 * p2 * x;
   }
   return distorted;
 }
@@ -85,7 +90,10 @@ Eigen::Vector2d ApplyHomography(const Eigen::Matrix3d& h, const Eigen::Vector2d&
 // OpenCV's whole pinhole distortion: DistortRational, then the tilt for kTilted.
 Eigen::Vector2d DistortOpenCv(const CameraModel& camera, const Eigen::Vector2d& p,
                               Matrix2d* jacobian) {
-  const Eigen::Vector2d distorted = DistortRational(camera.distortion, p, jacobian);
+  if (camera.model == DistortionModel::kRadTan) {
+    return DistortRational<true>(camera.distortion, p, jacobian);
+  }
+  const Eigen::Vector2d distorted = DistortRational<false>(camera.distortion, p, jacobian);
   if (camera.model != DistortionModel::kTilted) return distorted;
   Matrix2d tilt_jacobian;
   const Eigen::Vector2d tilted =
@@ -96,11 +104,12 @@ Eigen::Vector2d DistortOpenCv(const CameraModel& camera, const Eigen::Vector2d& 
 }
 
 // Newton on DistortRational(p) = distorted, started at the distorted point.
+template <bool kRadTanOnly>
 Eigen::Vector2d UndistortRational(const Coefficients& d, const Eigen::Vector2d& distorted) {
   Eigen::Vector2d p = distorted;
   for (int i = 0; i < kMaxUndistortIterations; ++i) {
     Matrix2d jacobian;
-    const Eigen::Vector2d residual = DistortRational(d, p, &jacobian) - distorted;
+    const Eigen::Vector2d residual = DistortRational<kRadTanOnly>(d, p, &jacobian) - distorted;
     const double determinant = jacobian(0, 0) * jacobian(1, 1) - jacobian(0, 1) * jacobian(1, 0);
     const Eigen::Vector2d step(
         (jacobian(1, 1) * residual.x() - jacobian(0, 1) * residual.y()) / determinant,
@@ -220,13 +229,15 @@ Eigen::Vector2d CameraModel::Unproject(const Eigen::Vector2d& pixel) const {
     case DistortionModel::kNone:
       return distorted;
     case DistortionModel::kRadTan:
+      return UndistortRational<true>(distortion, distorted);
     case DistortionModel::kRational:
     case DistortionModel::kThinPrism:
-      return UndistortRational(distortion, distorted);
+      return UndistortRational<false>(distortion, distorted);
     case DistortionModel::kTilted: {
       // The tilt is a homography: undone exactly before the iterative part.
       const Eigen::Matrix3d tilt = TiltHomography(distortion[12], distortion[13]);
-      return UndistortRational(distortion, ApplyHomography(tilt.inverse(), distorted, nullptr));
+      return UndistortRational<false>(distortion,
+                                      ApplyHomography(tilt.inverse(), distorted, nullptr));
     }
     case DistortionModel::kEquidistant: {
       const double theta_d = distorted.norm();
