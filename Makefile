@@ -3,7 +3,7 @@ BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
 
-.PHONY: all deps configure build test demo bench format clean
+.PHONY: all deps configure build build-binary test demo bench format clean
 
 all: build
 
@@ -16,10 +16,14 @@ configure: deps
 build: configure
 	cmake --build $(BUILD) -j$(JOBS)
 
+# The `arucoslam` binary alone (no tests or benchmarks): what the demo runs.
+build-binary: configure
+	cmake --build $(BUILD) -j$(JOBS) --target arucoslam
+
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j$(JOBS)
 
-demo: build
+demo: build-binary
 	$(BUILD)/bin/arucoslam demo --out out/demo
 
 bench: build

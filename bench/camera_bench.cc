@@ -1,5 +1,7 @@
 // Throughput of the camera models: Project, Unproject (iterative) and ProjectJacobian for
-// pinhole, radial-tangential (EuRoC cam0) and equidistant fisheye (TUM-VI cam0) cameras.
+// pinhole, radial-tangential (EuRoC cam0), equidistant fisheye (TUM-VI cam0), rational
+// (PhotonVision's LifeCam) and tilted-sensor (the LifeCam with thin-prism terms and a tilt)
+// cameras.
 #include <benchmark/benchmark.h>
 
 #include <Eigen/Geometry>
@@ -13,7 +15,19 @@ namespace {
 
 CameraModel BenchCamera(DistortionModel model) {
   CameraModel camera;
-  if (model == DistortionModel::kEquidistant) {
+  if (model == DistortionModel::kRational || model == DistortionModel::kTilted) {
+    camera.width = 1280;
+    camera.height = 720;
+    camera.fx = 1144.027;
+    camera.fy = 1142.187;
+    camera.cx = 604.858;
+    camera.cy = 343.699;
+    camera.distortion = {0.16443, -0.98662, 0.003473, -0.002772, 1.89095, 0.04109, 0.06374,
+                         -0.06795};
+    if (model == DistortionModel::kTilted) {
+      for (int i = 8; i < 14; ++i) camera.distortion[i] = i < 12 ? 0.002 : 0.03;
+    }
+  } else if (model == DistortionModel::kEquidistant) {
     camera.width = 512;
     camera.height = 512;
     camera.fx = 190.978;
@@ -103,6 +117,12 @@ BENCHMARK_CAPTURE(BM_Unproject, radtan, DistortionModel::kRadTan);
 BENCHMARK_CAPTURE(BM_Unproject, equidistant, DistortionModel::kEquidistant);
 BENCHMARK_CAPTURE(BM_ProjectJacobian, radtan, DistortionModel::kRadTan);
 BENCHMARK_CAPTURE(BM_ProjectJacobian, equidistant, DistortionModel::kEquidistant);
+BENCHMARK_CAPTURE(BM_Project, rational, DistortionModel::kRational);
+BENCHMARK_CAPTURE(BM_Project, tilted, DistortionModel::kTilted);
+BENCHMARK_CAPTURE(BM_Unproject, rational, DistortionModel::kRational);
+BENCHMARK_CAPTURE(BM_Unproject, tilted, DistortionModel::kTilted);
+BENCHMARK_CAPTURE(BM_ProjectJacobian, rational, DistortionModel::kRational);
+BENCHMARK_CAPTURE(BM_ProjectJacobian, tilted, DistortionModel::kTilted);
 
 }  // namespace
 }  // namespace arucoslam

@@ -1,11 +1,12 @@
-// `run`'s ROS 1 bag input: a FrameFeed over one image topic of a bag (ros/bag_reader.h). In a
+// `run`'s ROS 1 bag input: a FrameSource over one image topic of a bag (ros/bag_reader.h). In a
 // build without ROS, opening a bag is an InputError that says so.
 #pragma once
 
 #include <filesystem>
+#include <memory>
 #include <string>
 
-#include "arucoslam/exe/slam_run.h"
+#include "arucoslam/io/frame_source.h"
 
 namespace arucoslam {
 
@@ -19,6 +20,7 @@ struct BagFeedOptions {
 bool IsBagDataset(const std::filesystem::path& path);
 
 // Throws InputError naming the bag (see BagImageSource::Open) or, without ROS, saying so.
-FrameFeed OpenBagFeed(const std::filesystem::path& path, const BagFeedOptions& options);
+std::unique_ptr<FrameSource> OpenBagSource(const std::filesystem::path& path,
+                                           const BagFeedOptions& options);
 
 }  // namespace arucoslam

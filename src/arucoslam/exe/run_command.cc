@@ -1,9 +1,11 @@
-// `arucoslam run`: monocular SLAM over a sequence (EuRoC layout, TUM RGB-D folder, image
-// folder or one image topic of a ROS 1 bag) -> trajectory.tum, keyframes.tum, map.ply,
-// stats.json (and with markers markers.json: the known markers and the ones mapped online)
-// in one output folder;
-// map reuse: --save-map writes the map file after the run, --load-map starts from one,
-// --localize-only tracks against it without changing it.
+// `arucoslam run`: monocular SLAM over a sequence (EuRoC layout, TUM RGB-D folder, KITTI
+// odometry folder, image folder, video file or one image topic of a ROS 1 bag) or a live
+// camera -> trajectory.tum,
+// keyframes.tum, map.ply, stats.json (and with markers markers.json: the known markers and the
+// ones mapped online) in one output folder; map reuse: --save-map writes the map file after the
+// run, --load-map starts from one, --localize-only tracks against it without changing it.
+#include <atomic>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -15,7 +17,9 @@
 #include "arucoslam/exe/command.h"
 #include "arucoslam/exe/default_vocabulary.h"
 #include "arucoslam/exe/slam_run.h"
-#include "arucoslam/io/dataset_reader.h"
+#include "arucoslam/io/calibration.h"
+#include "arucoslam/io/camera_source.h"
+#include "arucoslam/io/frame_source.h"
 #include "arucoslam/io/marker_map_json.h"
 #include "arucoslam/util/error.h"
 #include "arucoslam/util/files.h"
@@ -25,6 +29,8 @@ namespace {
 
 struct RunArgs {
   std::string dataset;
+  std::string device;  // a live camera instead of a dataset
+  std::size_t max_frames = 0;
   std::string out;
   std::string camera;
   std::string image_topic;        // ROS bag only
@@ -60,35 +66,74 @@ void CheckMapArgs(const RunArgs& args) {
   }
 }
 
+// Set by SIGINT: the run stops reading frames and still writes its outputs.
+std::atomic<bool> g_stop_requested{false};
+
+extern "C" void RequestStop(int) {
+  g_stop_requested = true;
+  std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C ends the program at once
+}
+
+// Routes SIGINT to RequestStop while a run is in progress.
+class StopOnInterrupt {
+ public:
+  StopOnInterrupt() : previous_(std::signal(SIGINT, RequestStop)) { g_stop_requested = false; }
+  ~StopOnInterrupt() { std::signal(SIGINT, previous_); }
+  StopOnInterrupt(const StopOnInterrupt&) = delete;
+  StopOnInterrupt& operator=(const StopOnInterrupt&) = delete;
+
+ private:
+  void (*previous_)(int);
+};
+
+std::unique_ptr<FrameSource> OpenSource(const RunArgs& args) {
+  if (args.dataset.empty() == args.device.empty()) {
+    throw InputError("--dataset", "give either --dataset PATH or --device CAMERA");
+  }
+  const bool bag = args.device.empty() && IsBagDataset(args.dataset);
+  if (!bag && (!args.image_topic.empty() || !args.camera_info_topic.empty())) {
+    throw InputError(args.image_topic.empty() ? "--camera-info-topic" : "--image-topic",
+                     "only for a ROS bag (--dataset FILE.bag)");
+  }
+  if (bag) {
+    return OpenBagSource(args.dataset,
+                         {args.image_topic, args.camera_info_topic, args.camera});
+  }
+  if (args.device.empty()) {
+    DatasetOptions dataset_options;
+    dataset_options.camera_path = args.camera;
+    dataset_options.rate_hz = args.rate_hz;
+    return OpenFrameSource(args.dataset, dataset_options);
+  }
+  if (args.camera.empty()) {
+    throw InputError("--device", "a live camera needs a camera calibration file (--camera)");
+  }
+  CameraSourceOptions camera_options;
+  camera_options.stop = &g_stop_requested;
+  // V4L2 for device paths and camera indices; anything else (a stream URL) as OpenCV sees fit.
+  const bool index =
+      !args.device.empty() && args.device.find_first_not_of("0123456789") == std::string::npos;
+  camera_options.api = args.device.starts_with("/dev/") || index ? cv::CAP_V4L2 : cv::CAP_ANY;
+  return std::make_unique<CameraSource>(args.device, ReadCameraModel(args.camera), camera_options);
+}
+
 int RunSlam(const RunArgs& args) {
   if (args.num_features < 100) {
-    throw InputError("--features", "expected at least 100, got " + std::to_string(args.num_features));
+    throw InputError("--features",
+                     "expected at least 100, got " + std::to_string(args.num_features));
   }
   if (args.rate_hz < 0.0) throw InputError("--rate", "expected a rate >= 0 Hz");
   CheckMapArgs(args);
   if (!(args.marker_size_m >= 0.0)) {
-    throw InputError("--marker-size", "expected a side >= 0 m, got " + std::to_string(args.marker_size_m));
-  }
-  std::optional<Dataset> dataset;
-  FrameFeed frames;
-  if (IsBagDataset(args.dataset)) {
-    frames = OpenBagFeed(args.dataset, {args.image_topic, args.camera_info_topic, args.camera});
-  } else {
-    if (!args.image_topic.empty() || !args.camera_info_topic.empty()) {
-      throw InputError(args.image_topic.empty() ? "--camera-info-topic" : "--image-topic",
-                       "only for a ROS bag (--dataset FILE.bag)");
-    }
-    DatasetOptions dataset_options;
-    dataset_options.camera_path = args.camera;
-    dataset_options.rate_hz = args.rate_hz;
-    dataset = Dataset::Open(args.dataset, dataset_options);
-    frames = DatasetFeed(*dataset);
+    throw InputError("--marker-size",
+                     "expected a side >= 0 m, got " + std::to_string(args.marker_size_m));
   }
   if (std::filesystem::exists(args.out) && !std::filesystem::is_directory(args.out)) {
     throw InputError(args.out, "exists and is not a directory");
   }
-  std::optional<std::filesystem::path> markers_path;
-  if (dataset) markers_path = dataset->markers_path();
+  const StopOnInterrupt stop_on_interrupt;
+  const std::unique_ptr<FrameSource> source = OpenSource(args);
+  std::optional<std::filesystem::path> markers_path = source->markers_path();
   if (!args.markers.empty()) markers_path = args.markers;
   if (args.no_markers) markers_path.reset();
   if (args.ground_vehicle && !markers_path) {  // before the vocabulary's load: fail fast
@@ -96,9 +141,9 @@ int RunSlam(const RunArgs& args) {
   }
   const std::filesystem::path vocabulary =
       args.vocabulary.empty() ? DefaultVocabularyPath() : std::filesystem::path(args.vocabulary);
-  SystemOptions options =
-      DefaultRunOptions(args.blocking, std::make_shared<const Vocabulary>(Vocabulary::Load(vocabulary)),
-                        !args.no_loop_closing);
+  SystemOptions options = DefaultRunOptions(
+      args.blocking, std::make_shared<const Vocabulary>(Vocabulary::Load(vocabulary)),
+      !args.no_loop_closing);
   options.extractor.num_features = args.num_features;
   if (markers_path) {
     options.marker_map = ReadMarkerMapJson(*markers_path);
@@ -108,11 +153,15 @@ int RunSlam(const RunArgs& args) {
   const bool markers = options.marker_map.has_value();
   if (args.ground_vehicle) options.marker_mapping.ground_plane_prior = GroundPlanePriorOptions{};
   MapReuse reuse;
-  if (!args.load_map.empty()) LoadMapForRun(args.load_map, frames.camera, reuse);
+  if (!args.load_map.empty()) LoadMapForRun(args.load_map, source->camera(), reuse);
   reuse.localize_only = args.localize_only;
   reuse.save = args.save_map;
-  const SlamRunResult result = RunSlamOnFrames(frames, args.dataset, options, markers,
-                                               args.out, !args.quiet, std::move(reuse));
+  RunControl control;
+  control.max_frames = args.max_frames;
+  control.stop = &g_stop_requested;
+  const SlamRunResult result =
+      RunSlamOnSource(*source, args.device.empty() ? args.dataset : args.device, options, markers,
+                      args.out, !args.quiet, std::move(reuse), control);
   std::printf("%s\n", SlamRunSummary(result, args.out).c_str());
   if (!args.save_map.empty()) {
     std::printf("map saved to %s (%d keyframes, %d points)\n", args.save_map.c_str(),
@@ -125,23 +174,35 @@ int RunSlam(const RunArgs& args) {
 
 void AddRunCommand(CLI::App& app, int& exit_status) {
   auto args = std::make_shared<RunArgs>();
-  CLI::App* run = app.add_subcommand(
-      "run", "SLAM on a sequence -> trajectory.tum, keyframes.tum, map.ply, stats.json "
-             "(+ markers.json with a marker map)");
-  run->add_option("--dataset", args->dataset,
-                  "the sequence: EuRoC layout (mav0/cam0), TUM RGB-D folder, image folder or "
-                  "ROS 1 bag (FILE.bag, with --image-topic)")
-      ->required();
+  CLI::App* run =
+      app.add_subcommand("run",
+                         "SLAM on a sequence -> trajectory.tum, keyframes.tum, map.ply, stats.json "
+                         "(+ markers.json with a marker map)");
+  CLI::Option* dataset =
+      run->add_option("--dataset", args->dataset,
+                      "the sequence: EuRoC layout (mav0/cam0), TUM RGB-D folder, KITTI odometry "
+                      "folder (image_0/, calib.txt, times.txt), image folder, video file or "
+                      "ROS 1 bag (FILE.bag, with --image-topic)");
+  CLI::Option* device = run->add_option(
+      "--device", args->device,
+      "a live camera instead of --dataset: /dev/videoN (V4L2) or a camera index; needs "
+      "--camera; Ctrl-C ends the run and writes its outputs; frames the SLAM has no time for "
+      "are dropped (stats.json frames.dropped)");
+  dataset->excludes(device);
+  device->excludes(dataset);
   run->add_option("--image-topic", args->image_topic,
                   "ROS bag: the image topic (sensor_msgs/Image or CompressedImage)");
   run->add_option("--camera-info-topic", args->camera_info_topic,
                   "ROS bag: the sensor_msgs/CameraInfo topic (default: the image topic's "
                   "namespace + /camera_info; --camera replaces it)");
+  run->add_option("--max-frames", args->max_frames, "stop after this many frames (0: all)")
+      ->capture_default_str();
   run->add_option("--out", args->out, "output folder (replaced only when the run succeeds)")
       ->required();
   run->add_option("--camera", args->camera,
-                  "calibration file (EuRoC sensor.yaml, ORB-SLAM3 settings or ROS camera_info); "
-                  "required for TUM and image folders, and for bags without camera_info");
+                  "calibration file (EuRoC sensor.yaml, OpenCV YAML/XML, Kalibr camchain, ROS "
+                  "camera_info or ORB-SLAM3 settings); required for TUM, image folders, videos "
+                  "and live cameras, replaces the sequence's own for EuRoC, KITTI and bags");
   run->add_flag("--no-markers", args->no_markers,
                 "ignore the sequence's markers.json (keypoints only). Without this flag a "
                 "markers.json in the sequence puts the run in the marker world frame, with "
@@ -166,7 +227,9 @@ void AddRunCommand(CLI::App& app, int& exit_status) {
   run->add_flag("--quiet", args->quiet, "no progress line");
   run->add_option("--features", args->num_features, "ORB features per image")
       ->capture_default_str();
-  run->add_option("--rate", args->rate_hz, "image folder frame rate in Hz (0: from the camera)")
+  run->add_option("--rate", args->rate_hz,
+                  "frame rate in Hz giving the timestamps of an image folder (0: from the "
+                  "camera file) or a video (0: the container's timestamps)")
       ->capture_default_str();
   run->add_option("--save-map", args->save_map,
                   "write the map to this file after the run (binary, versioned)");

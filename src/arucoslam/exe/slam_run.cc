@@ -2,12 +2,14 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <utility>
 
-#include "arucoslam/util/error.h"
 #include "arucoslam/io/marker_map_json.h"
+#include "arucoslam/util/error.h"
 #include "arucoslam/util/files.h"
 #include "arucoslam/util/timing.h"
 
@@ -20,12 +22,13 @@ Trajectory ToTrajectory(const std::vector<StampedPose>& poses) {
   return trajectory;
 }
 
-SlamRunStats MakeStats(const std::string& dataset_label, const std::string& layout,
+SlamRunStats MakeStats(const std::string& dataset_label, const FrameSource& source,
                        const System& system, bool blocking, bool markers, double wall_time_s) {
   const SystemStats stats = system.Stats();
   SlamRunStats out;
   out.dataset = dataset_label;
-  out.layout = layout;
+  out.layout = source.layout();
+  out.frames_dropped = static_cast<int>(source.frames_dropped());
   out.blocking = blocking;
   out.markers = markers;
   out.frames = stats.num_frames;
@@ -62,8 +65,7 @@ SlamRunStats MakeStats(const std::string& dataset_label, const std::string& layo
                     {"tracking", stats.tracking_ms.Summarize()},
                     {"frame", stats.frame_ms.Summarize()},
                     {"local_mapping", stats.local_mapping_ms.Summarize()}};
-  if (stats.places.loop_detection_ms.Count() > 0 ||
-      stats.places.num_relocalization_attempts > 0) {
+  if (stats.places.loop_detection_ms.Count() > 0 || stats.places.num_relocalization_attempts > 0) {
     out.timings_ms.push_back({"relocalisation", stats.places.relocalization_ms.Summarize()});
     out.timings_ms.push_back({"loop_detection", stats.places.loop_detection_ms.Summarize()});
     out.timings_ms.push_back({"loop_correction", stats.places.loop_correction_ms.Summarize()});
@@ -79,8 +81,7 @@ SlamRunStats MakeStats(const std::string& dataset_label, const std::string& layo
 
 }  // namespace
 
-void LoadMapForRun(const std::filesystem::path& path, const CameraModel& camera,
-                   MapReuse& reuse) {
+void LoadMapForRun(const std::filesystem::path& path, const CameraModel& camera, MapReuse& reuse) {
   MapData map = LoadMapFile(path, &reuse.loaded_info);
   if (map.NumKeyframes() == 0) throw InputError(path.string(), "the map has no keyframes");
   const CameraModel& mapped = map.keyframes().begin()->second.camera;
@@ -108,41 +109,41 @@ SystemOptions DefaultRunOptions(bool blocking, std::shared_ptr<const Vocabulary>
   return options;
 }
 
-FrameFeed DatasetFeed(const Dataset& dataset) {
-  FrameFeed frames;
-  frames.layout = DatasetLayoutName(dataset.layout());
-  frames.camera = dataset.camera();
-  frames.size = dataset.size();
-  frames.timestamp_s = [&dataset](std::size_t i) { return dataset.frame(i).timestamp_s; };
-  frames.load_image = [&dataset](std::size_t i) { return dataset.LoadImage(i); };
-  return frames;
-}
-
-SlamRunResult RunSlamOnDataset(const Dataset& dataset, const std::string& dataset_label,
-                               const SystemOptions& options, bool markers,
-                               const std::filesystem::path& out_dir, bool progress,
-                               MapReuse reuse) {
-  return RunSlamOnFrames(DatasetFeed(dataset), dataset_label, options, markers, out_dir,
-                         progress, std::move(reuse));
-}
-
-SlamRunResult RunSlamOnFrames(const FrameFeed& frames, const std::string& dataset_label,
+SlamRunResult RunSlamOnSource(FrameSource& source, const std::string& dataset_label,
                               const SystemOptions& options, bool markers,
-                              const std::filesystem::path& out_dir, bool progress,
-                              MapReuse reuse) {
+                              const std::filesystem::path& out_dir, bool progress, MapReuse reuse,
+                              const RunControl& control) {
   StagedDirectory staged(out_dir);
   const Stopwatch wall;
-  System system(frames.camera, options);
+  System system(source.camera(), options);
   if (reuse.loaded) {
     system.StartFromMap(std::move(*reuse.loaded), reuse.loaded_info.world_aligned,
                         reuse.localize_only);
   }
-  for (std::size_t i = 0; i < frames.size; ++i) {
-    const FrameReport report = system.ProcessImage(frames.load_image(i), frames.timestamp_s(i));
-    if (progress && (i % 10 == 0 || i + 1 == frames.size)) {
-      std::fprintf(stderr, "\rframe %zu/%zu  %-15s keyframes %zu  points %zu", i + 1,
-                   frames.size, TrackingStateName(report.state).c_str(),
-                   system.map().NumKeyframes(), system.map().NumMapPoints());
+  const auto stop_requested = [&control] {
+    return control.stop != nullptr && control.stop->load();
+  };
+  std::optional<std::size_t> total = source.size();
+  if (total && control.max_frames > 0) total = std::min(*total, control.max_frames);
+  std::size_t processed = 0;
+  bool interrupted = false;
+  while (control.max_frames == 0 || processed < control.max_frames) {
+    if (stop_requested()) {
+      interrupted = true;
+      break;
+    }
+    std::optional<SourceFrame> frame = source.Next();
+    if (!frame) {
+      interrupted = stop_requested();  // a live source ends on the same request
+      break;
+    }
+    const FrameReport report = system.ProcessImage(frame->image, frame->timestamp_s);
+    ++processed;
+    if (progress && (processed % 10 == 1 || (total && processed == *total))) {
+      std::fprintf(stderr, "\rframe %zu%s  %-15s keyframes %zu  points %zu", processed,
+                   total ? fmt::format("/{}", *total).c_str() : "",
+                   TrackingStateName(report.state).c_str(), system.map().NumKeyframes(),
+                   system.map().NumMapPoints());
       std::fflush(stderr);
     }
   }
@@ -150,7 +151,8 @@ SlamRunResult RunSlamOnFrames(const FrameFeed& frames, const std::string& datase
   if (progress) std::fprintf(stderr, "\n");
   SlamRunResult result;
   result.stats =
-      MakeStats(dataset_label, frames.layout, system, options.blocking, markers, wall.ElapsedSeconds());
+      MakeStats(dataset_label, source, system, options.blocking, markers, wall.ElapsedSeconds());
+  result.stats.interrupted = interrupted;
   result.trajectory = ToTrajectory(system.Trajectory());
   result.keyframes = ToTrajectory(system.KeyframePoses());
   result.timing = system.Stats();
@@ -169,6 +171,15 @@ SlamRunResult RunSlamOnFrames(const FrameFeed& frames, const std::string& datase
   return result;
 }
 
+SlamRunResult RunSlamOnDataset(const Dataset& dataset, const std::string& dataset_label,
+                               const SystemOptions& options, bool markers,
+                               const std::filesystem::path& out_dir, bool progress,
+                               MapReuse reuse) {
+  DatasetSource source(dataset);
+  return RunSlamOnSource(source, dataset_label, options, markers, out_dir, progress,
+                         std::move(reuse));
+}
+
 std::string SlamRunSummary(const SlamRunResult& result, const std::string& out_dir) {
   const SlamRunStats& stats = result.stats;
   std::string line = fmt::format(
@@ -178,6 +189,10 @@ std::string SlamRunSummary(const SlamRunResult& result, const std::string& out_d
       stats.frames > 0 ? 100.0 * stats.frames_tracked / stats.frames : 0.0, stats.losses,
       stats.keyframes, stats.map_points, result.timing.tracking_ms.Summarize().median,
       result.timing.local_mapping_ms.Summarize().median, stats.wall_time_s, out_dir);
+  if (stats.frames_dropped > 0) {
+    line += fmt::format("; {} frames dropped (the SLAM was busy)", stats.frames_dropped);
+  }
+  if (stats.interrupted) line += "; stopped early on request";
   if (stats.initializations == 0 && stats.keyframes == 0) {
     line += "\nmap not initialised (no camera motion found)";
   }

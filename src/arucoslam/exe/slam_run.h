@@ -1,16 +1,19 @@
-// RunSlamOnDataset: one SLAM run over a whole sequence, shared by `run` and `experiments`:
-// feeds every image to the System, then writes trajectory.tum, keyframes.tum, map.ply and
-// stats.json (and with a marker map markers.json: known + mapped markers) into an output
-// folder (all-or-nothing); optionally starts from a saved map and saves the map after the run.
+// RunSlamOnSource: one SLAM run over a frame source (file sequence, video or live camera),
+// shared by `run` and `experiments`: feeds every frame to the System, then writes trajectory.tum,
+// keyframes.tum, map.ply and stats.json (and with a marker map markers.json: known + mapped
+// markers) into an output folder (all-or-nothing); optionally starts from a saved map and saves the
+// map after the run.
 #pragma once
 
+#include <atomic>
+#include <cstddef>
 #include <filesystem>
-#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
 
 #include "arucoslam/io/dataset_reader.h"
+#include "arucoslam/io/frame_source.h"
 #include "arucoslam/io/map_file.h"
 #include "arucoslam/io/slam_output.h"
 #include "arucoslam/io/trajectory_io.h"
@@ -22,14 +25,13 @@ namespace arucoslam {
 struct MapReuse {
   std::optional<MapData> loaded;  // start from this map (LoadMapForRun)
   MapFileInfo loaded_info;
-  bool localize_only = false;     // track against `loaded` without changing it
-  std::filesystem::path save;     // empty: the map is not saved
+  bool localize_only = false;  // track against `loaded` without changing it
+  std::filesystem::path save;  // empty: the map is not saved
 };
 
 // Reads a map file for a run on `camera`'s images; InputError naming the file when it is
 // missing, bad, empty or made with another camera.
-void LoadMapForRun(const std::filesystem::path& path, const CameraModel& camera,
-                   MapReuse& reuse);
+void LoadMapForRun(const std::filesystem::path& path, const CameraModel& camera, MapReuse& reuse);
 
 struct SlamRunResult {
   Trajectory trajectory;  // every frame with a pose, world_from_cam
@@ -45,25 +47,20 @@ struct SlamRunResult {
 SystemOptions DefaultRunOptions(bool blocking, std::shared_ptr<const Vocabulary> vocabulary,
                                 bool loop_closing);
 
-// The frames a run reads, from a Dataset or another source (a ROS 1 bag, exe/bag_feed.h).
-struct FrameFeed {
-  std::string layout;  // stats.json's "layout"
-  CameraModel camera;
-  std::size_t size = 0;
-  std::function<double(std::size_t)> timestamp_s;   // increasing
-  std::function<cv::Mat(std::size_t)> load_image;  // 8-bit grey; may throw InputError
+// When a run ends before its source does. Either way the outputs are written for the frames
+// processed so far.
+struct RunControl {
+  std::size_t max_frames = 0;               // stop after this many frames; 0: no limit
+  const std::atomic<bool>* stop = nullptr;  // stop once set (Ctrl-C); may be null
 };
-
-// The frames of `dataset`, which must outlive the feed.
-FrameFeed DatasetFeed(const Dataset& dataset);
 
 // `dataset_label` names the dataset in stats.json; `markers` says whether the run used the
 // sequence's marker map. A progress line goes to stderr when `progress` is set.
-SlamRunResult RunSlamOnFrames(const FrameFeed& frames, const std::string& dataset_label,
+SlamRunResult RunSlamOnSource(FrameSource& source, const std::string& dataset_label,
                               const SystemOptions& options, bool markers,
                               const std::filesystem::path& out_dir, bool progress,
-                              MapReuse reuse = {});
-// RunSlamOnFrames on DatasetFeed(dataset).
+                              MapReuse reuse = {}, const RunControl& control = {});
+// The same over every frame of a file sequence.
 SlamRunResult RunSlamOnDataset(const Dataset& dataset, const std::string& dataset_label,
                                const SystemOptions& options, bool markers,
                                const std::filesystem::path& out_dir, bool progress,

@@ -49,6 +49,47 @@ CameraModel TumViFisheye() {
   return camera;
 }
 
+// PhotonVision's LifeCam HD-3000 at 1280x720: OpenCV's rational model (8 coefficients).
+CameraModel LifeCamRational() {
+  CameraModel camera;
+  camera.width = 1280;
+  camera.height = 720;
+  camera.fx = 1144.0265829623002;
+  camera.fy = 1142.1874735882805;
+  camera.cx = 604.8583376755885;
+  camera.cy = 343.69882696120504;
+  camera.model = DistortionModel::kRational;
+  camera.distortion = {0.16442580388260605,   -0.9866244487633755, 0.003472548710624201,
+                       -0.002772366031203418, 1.8909532518418533,  0.04108971525533507,
+                       0.06374355932009733,   -0.0679460705265192};
+  return camera;
+}
+
+// The LifeCam with thin-prism terms (s1..s4) added.
+CameraModel ThinPrism() {
+  CameraModel camera = LifeCamRational();
+  camera.model = DistortionModel::kThinPrism;
+  camera.distortion[8] = 0.004;
+  camera.distortion[9] = -0.002;
+  camera.distortion[10] = 0.003;
+  camera.distortion[11] = 0.001;
+  return camera;
+}
+
+// The thin-prism camera on a sensor tilted by 0.03 rad about x and -0.05 rad about y.
+CameraModel Tilted() {
+  CameraModel camera = ThinPrism();
+  camera.model = DistortionModel::kTilted;
+  camera.distortion[12] = 0.03;
+  camera.distortion[13] = -0.05;
+  return camera;
+}
+
+// Every pinhole camera of OpenCV's family above, for tests that hold for all of them.
+std::vector<CameraModel> OpenCvFamily() {
+  return {EurocRadTan(), RadTanWithK3(), LifeCamRational(), ThinPrism(), Tilted()};
+}
+
 cv::Matx33d CameraMatrix(const CameraModel& camera) {
   return cv::Matx33d(camera.fx, 0.0, camera.cx, 0.0, camera.fy, camera.cy, 0.0, 0.0, 1.0);
 }
@@ -89,10 +130,9 @@ void ExpectProjectMatchesOpenCv(const CameraModel& camera) {
   const auto points = RandomPointsInCone(0.9, 500, 7);
   std::vector<cv::Point2d> expected;
   const cv::Vec3d zero(0.0, 0.0, 0.0);
-  const std::vector<double> d(camera.distortion.begin(), camera.distortion.end());
+  const std::vector<double> d = camera.DistortionCoefficients();
   if (camera.model == DistortionModel::kEquidistant) {
-    cv::fisheye::projectPoints(ToCv(points), expected, zero, zero, CameraMatrix(camera),
-                               std::vector<double>(d.begin(), d.begin() + 4));
+    cv::fisheye::projectPoints(ToCv(points), expected, zero, zero, CameraMatrix(camera), d);
   } else {
     cv::projectPoints(ToCv(points), zero, zero, CameraMatrix(camera), d, expected);
   }
@@ -104,9 +144,11 @@ void ExpectProjectMatchesOpenCv(const CameraModel& camera) {
   }
 }
 
-TEST(CameraModelTest, RadTanProjectMatchesOpenCvProjectPoints) {
-  ExpectProjectMatchesOpenCv(EurocRadTan());
-  ExpectProjectMatchesOpenCv(RadTanWithK3());
+TEST(CameraModelTest, OpenCvFamilyProjectMatchesOpenCvProjectPoints) {
+  for (const CameraModel& camera : OpenCvFamily()) {
+    SCOPED_TRACE(DistortionModelName(camera.model));
+    ExpectProjectMatchesOpenCv(camera);
+  }
 }
 
 TEST(CameraModelTest, EquidistantProjectMatchesOpenCvFisheyeProjectPoints) {
@@ -133,12 +175,13 @@ TEST(CameraModelTest, ProjectRejectsPointsBehindTheCamera) {
   }
 }
 
-TEST(CameraModelTest, RadTanUnprojectMatchesOpenCvUndistortPoints) {
-  for (const CameraModel& camera : {EurocRadTan(), RadTanWithK3()}) {
+TEST(CameraModelTest, OpenCvFamilyUnprojectMatchesOpenCvUndistortPoints) {
+  for (const CameraModel& camera : OpenCvFamily()) {
+    SCOPED_TRACE(DistortionModelName(camera.model));
     const auto pixels = PixelGrid(camera, 1e9);
     std::vector<cv::Point2d> cv_pixels, expected;
     for (const auto& pixel : pixels) cv_pixels.emplace_back(pixel.x(), pixel.y());
-    const std::vector<double> d(camera.distortion.begin(), camera.distortion.end());
+    const std::vector<double> d = camera.DistortionCoefficients();
     cv::undistortPoints(
         cv_pixels, expected, CameraMatrix(camera), d, cv::noArray(), cv::noArray(),
         cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 500, 1e-14));
@@ -161,8 +204,7 @@ TEST(CameraModelTest, EquidistantUnprojectMatchesOpenCvFisheyeUndistortPoints) {
   std::vector<cv::Point2d> cv_pixels, expected;
   for (const auto& pixel : pixels) cv_pixels.emplace_back(pixel.x(), pixel.y());
   cv::fisheye::undistortPoints(
-      cv_pixels, expected, CameraMatrix(camera),
-      std::vector<double>(camera.distortion.begin(), camera.distortion.begin() + 4), cv::noArray(),
+      cv_pixels, expected, CameraMatrix(camera), camera.DistortionCoefficients(), cv::noArray(),
       cv::noArray(),
       cv::TermCriteria(cv::TermCriteria::MAX_ITER + cv::TermCriteria::EPS, 100, 1e-15));
   for (std::size_t i = 0; i < pixels.size(); ++i) {
@@ -181,8 +223,9 @@ TEST(CameraModelTest, UnprojectInvertsProjectOverTheImage) {
     CameraModel camera;
     double max_radius;
   };
-  for (const Case& c :
-       {Case{EurocRadTan(), 1e9}, Case{RadTanWithK3(), 1e9}, Case{TumViFisheye(), 255.0}}) {
+  std::vector<Case> cases = {{TumViFisheye(), 255.0}};
+  for (const CameraModel& camera : OpenCvFamily()) cases.push_back({camera, 1e9});
+  for (const Case& c : cases) {
     double worst = 0.0;
     for (const auto& pixel : PixelGrid(c.camera, c.max_radius)) {
       const Eigen::Vector2d normalised = c.camera.Unproject(pixel);
@@ -196,7 +239,9 @@ TEST(CameraModelTest, UnprojectInvertsProjectOverTheImage) {
 }
 
 TEST(CameraModelTest, ProjectJacobianMatchesCentralDifferences) {
-  for (const CameraModel& camera : {EurocRadTan(), RadTanWithK3(), TumViFisheye()}) {
+  std::vector<CameraModel> cameras = OpenCvFamily();
+  cameras.push_back(TumViFisheye());
+  for (const CameraModel& camera : cameras) {
     // Include a point on the optical axis (the fisheye's small-radius branch).
     auto points = RandomPointsInCone(0.9, 200, 11);
     points.emplace_back(0.0, 0.0, 2.0);
@@ -239,6 +284,31 @@ TEST(CameraModelTest, CheckRejectsInvalidParameters) {
   camera = TumViFisheye();
   camera.distortion[4] = 0.1;  // equidistant has four coefficients
   EXPECT_FALSE(camera.Check());
+  for (const CameraModel& valid : OpenCvFamily()) EXPECT_TRUE(valid.Check());
+  camera = EurocRadTan();
+  camera.distortion[5] = 0.01;  // k4 belongs to the rational model
+  EXPECT_FALSE(camera.Check());
+  camera = LifeCamRational();
+  camera.distortion[8] = 0.01;  // s1 belongs to the thin-prism model
+  EXPECT_FALSE(camera.Check());
+  camera = ThinPrism();
+  camera.distortion[13] = 0.01;  // tauY belongs to the tilted model
+  EXPECT_FALSE(camera.Check());
+  camera = Tilted();
+  camera.distortion[12] = 2.0;  // beyond 90 degrees
+  EXPECT_FALSE(camera.Check());
+}
+
+TEST(CameraModelTest, DistortionCoefficientsAreTheModelsShareInOpenCvOrder) {
+  EXPECT_TRUE(PinholeCamera(640, 480, 500.0).DistortionCoefficients().empty());
+  EXPECT_EQ(EurocRadTan().DistortionCoefficients().size(), 5u);
+  EXPECT_EQ(TumViFisheye().DistortionCoefficients().size(), 4u);
+  EXPECT_EQ(LifeCamRational().DistortionCoefficients().size(), 8u);
+  EXPECT_EQ(ThinPrism().DistortionCoefficients().size(), 12u);
+  const std::vector<double> tilted = Tilted().DistortionCoefficients();
+  ASSERT_EQ(tilted.size(), 14u);
+  EXPECT_EQ(tilted[12], 0.03);
+  EXPECT_EQ(tilted[13], -0.05);
 }
 
 TEST(CameraModelTest, InImageUsesPixelCentresAndBorder) {

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <opencv2/core.hpp>
 #include <ostream>
 #include <string>
 
@@ -47,23 +48,33 @@ fs::path WriteFile(const std::string& name, const std::string& text) {
     GTEST_SKIP() << "test data missing: " << (kDataDir / (relative)).string(); \
   }
 
-TEST(CalibrationTest, ReadsTheRealEuRoCSensorYaml) {
-  REQUIRE_DATA("euroc_v101_micro/mav0/cam0/sensor.yaml");
-  const CameraCalibration calibration =
-      ReadCameraCalibration(kDataDir / "euroc_v101_micro/mav0/cam0/sensor.yaml");
-  const CameraModel& camera = calibration.camera;
-  EXPECT_EQ(calibration.format, CalibrationFormat::kEuRoC);
+// EuRoC MAV cam0 (V1_01 sensor.yaml), which several of the files below describe.
+void ExpectEurocCam0Intrinsics(const CameraModel& camera) {
   EXPECT_EQ(camera.width, 752);
   EXPECT_EQ(camera.height, 480);
   EXPECT_EQ(camera.fx, 458.654);
   EXPECT_EQ(camera.fy, 457.296);
   EXPECT_EQ(camera.cx, 367.215);
   EXPECT_EQ(camera.cy, 248.375);
+}
+
+void ExpectEurocCam0(const CameraModel& camera) {
+  ExpectEurocCam0Intrinsics(camera);
   EXPECT_EQ(camera.model, DistortionModel::kRadTan);
-  const std::array<double, 5> expected = {-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05, 0.0};
+  const std::array<double, kMaxDistortionCoefficients> expected = {-0.28340811, 0.07395907,
+                                                                   0.00019359, 1.76187114e-05, 0.0};
   EXPECT_EQ(camera.distortion, expected);
-  EXPECT_EQ(camera.rate_hz, 20.0);
   EXPECT_TRUE(camera.Check());
+}
+
+TEST(CalibrationTest, ReadsTheRealEuRoCSensorYaml) {
+  REQUIRE_DATA("euroc_v101_micro/mav0/cam0/sensor.yaml");
+  const CameraCalibration calibration =
+      ReadCameraCalibration(kDataDir / "euroc_v101_micro/mav0/cam0/sensor.yaml");
+  const CameraModel& camera = calibration.camera;
+  EXPECT_EQ(calibration.format, CalibrationFormat::kEuRoC);
+  ExpectEurocCam0(camera);
+  EXPECT_EQ(camera.rate_hz, 20.0);
   // T_BS: body_from_cam, first row 0.0148655429818, -0.999880929698, 0.00414029679422.
   EXPECT_TRUE(calibration.body_from_cam.translation.isApprox(
       Eigen::Vector3d(-0.0216401454975, -0.064676986768, 0.00981073058949), 1e-12));
@@ -86,8 +97,8 @@ TEST(CalibrationTest, ReadsTheRealFlatRosCameraInfoFiles) {
   EXPECT_EQ(camera.cx, 655.863924415);
   EXPECT_EQ(camera.cy, 490.614022124);
   EXPECT_EQ(camera.model, DistortionModel::kRadTan);
-  const std::array<double, 5> expected = {0.134973508728, -0.233586982745, 0.000669703031508,
-                                          0.00484673746587, 0.0};
+  const std::array<double, kMaxDistortionCoefficients> expected = {
+      0.134973508728, -0.233586982745, 0.000669703031508, 0.00484673746587, 0.0};
   EXPECT_EQ(camera.distortion, expected);
 
   const CameraModel bag =
@@ -135,6 +146,108 @@ distortion_coefficients: {rows: 1, cols: 4, data: [0.0035, 0.0007, -0.002, 0.000
   EXPECT_EQ(fisheye_camera.distortion[3], 0.0002);
 }
 
+TEST(CalibrationTest, ReadsTheRealOpenCvRational8Files) {
+  REQUIRE_DATA("photonvision_charuco_lifecam/camera_opencv.yaml");
+  const std::array<double, kMaxDistortionCoefficients> expected = {
+      0.16442580388260605, -0.9866244487633755, 0.003472548710624201, -0.002772366031203418,
+      1.8909532518418533,  0.04108971525533507, 0.06374355932009733,  -0.0679460705265192};
+  // The OpenCV FileStorage file and the sensor.yaml derived from it give the same camera.
+  for (const char* file : {"camera_opencv.yaml", "euroc/mav0/cam0/sensor.yaml"}) {
+    const CameraCalibration calibration =
+        ReadCameraCalibration(kDataDir / "photonvision_charuco_lifecam" / file);
+    const CameraModel& camera = calibration.camera;
+    EXPECT_EQ(calibration.format,
+              file[0] == 'c' ? CalibrationFormat::kOpenCv : CalibrationFormat::kEuRoC);
+    EXPECT_EQ(camera.width, 1280);
+    EXPECT_EQ(camera.height, 720);
+    EXPECT_EQ(camera.fx, 1144.0265829623002);
+    EXPECT_EQ(camera.fy, 1142.1874735882805);
+    EXPECT_EQ(camera.cx, 604.8583376755885);
+    EXPECT_EQ(camera.cy, 343.69882696120504);
+    EXPECT_EQ(camera.model, DistortionModel::kRational) << file;
+    EXPECT_EQ(camera.distortion, expected) << file;
+    EXPECT_TRUE(camera.Check());
+  }
+}
+
+// A camera of each of OpenCV's pinhole models, written by cv::FileStorage as YAML and as XML
+// (what OpenCV's calibration sample writes), reads back equal.
+TEST(CalibrationTest, ReadsOpenCvFileStorageYamlAndXml) {
+  const std::vector<double> all = {-0.28, 0.07,  0.0002, 0.00002, 0.01,   0.02, -0.03,
+                                   0.04,  0.001, -0.002, 0.003,   0.0005, 0.01, -0.02};
+  for (const std::size_t count : {0, 4, 5, 8, 12, 14}) {
+    for (const char* extension : {".yaml", ".xml"}) {
+      const fs::path path =
+          TempDir() / ("opencv_" + std::to_string(count) + std::string(extension));
+      {
+        cv::FileStorage storage(path.string(), cv::FileStorage::WRITE);
+        storage << "image_width" << 752 << "image_height" << 480;
+        storage << "camera_matrix"
+                << cv::Mat(
+                       cv::Matx33d(458.654, 0.0, 367.215, 0.0, 457.296, 248.375, 0.0, 0.0, 1.0));
+        storage << "distortion_coefficients"
+                << cv::Mat(std::vector<double>(all.begin(), all.begin() + count), true);
+        storage << "avg_reprojection_error" << 0.25;
+      }
+      const CameraCalibration calibration = ReadCameraCalibration(path);
+      SCOPED_TRACE(path.string());
+      EXPECT_EQ(calibration.format, CalibrationFormat::kOpenCv);
+      const CameraModel& camera = calibration.camera;
+      ExpectEurocCam0Intrinsics(camera);
+      const DistortionModel expected_model = count == 0    ? DistortionModel::kNone
+                                             : count <= 5  ? DistortionModel::kRadTan
+                                             : count == 8  ? DistortionModel::kRational
+                                             : count == 12 ? DistortionModel::kThinPrism
+                                                           : DistortionModel::kTilted;
+      EXPECT_EQ(camera.model, expected_model);
+      for (std::size_t i = 0; i < kMaxDistortionCoefficients; ++i) {
+        EXPECT_EQ(camera.distortion[i], i < count ? all[i] : 0.0) << i;
+      }
+      EXPECT_TRUE(camera.Check());
+    }
+  }
+}
+
+TEST(CalibrationTest, ReadsKalibrCamchain) {
+  const fs::path path = WriteFile("camchain.yaml", R"(cam0:
+  T_cam_imu:
+  - [0.0148655429818, 0.999557249008, -0.0257744366974, 0.0652229509055]
+  - [-0.999880929698, 0.0149672133247, 0.00375618835797, -0.0207064249118]
+  - [0.00414029679422, 0.0257155299480, 0.999660727178, -0.0080546303257]
+  - [0.0, 0.0, 0.0, 1.0]
+  cam_overlaps: [1]
+  camera_model: pinhole
+  distortion_coeffs: [-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05]
+  distortion_model: radtan
+  intrinsics: [458.654, 457.296, 367.215, 248.375]
+  resolution: [752, 480]
+  rostopic: /cam0/image_raw
+  timeshift_cam_imu: 0.0
+cam1:
+  camera_model: pinhole
+  distortion_model: equidistant
+)");
+  const CameraCalibration calibration = ReadCameraCalibration(path);
+  EXPECT_EQ(calibration.format, CalibrationFormat::kKalibr);
+  ExpectEurocCam0(calibration.camera);
+  // body (IMU) from camera is the inverse of T_cam_imu: EuRoC's T_BS.
+  EXPECT_TRUE(calibration.body_from_cam.translation.isApprox(
+      Eigen::Vector3d(-0.0216401454975, -0.064676986768, 0.00981073058949), 1e-6));
+  EXPECT_NEAR(calibration.body_from_cam.RotationMatrix()(0, 1), -0.999880929698, 1e-9);
+
+  const fs::path fisheye = WriteFile("camchain_fisheye.yaml", R"(cam0:
+  camera_model: pinhole
+  distortion_coeffs: [0.0035, 0.0007, -0.002, 0.0002]
+  distortion_model: equidistant
+  intrinsics: [190.5, 190.25, 254.5, 256.5]
+  resolution: [512, 512]
+)");
+  const CameraCalibration fisheye_calibration = ReadCameraCalibration(fisheye);
+  EXPECT_EQ(fisheye_calibration.camera.model, DistortionModel::kEquidistant);
+  EXPECT_EQ(fisheye_calibration.camera.distortion[3], 0.0002);
+  EXPECT_TRUE(fisheye_calibration.body_from_cam.ToMatrix().isIdentity());
+}
+
 // ORB-SLAM3's older settings layout (as its EuRoC.yaml), with the OpenCV directive line.
 TEST(CalibrationTest, ReadsOrbSlam3PinHoleSettings) {
   const fs::path path = WriteFile("orbslam3_euroc.yaml", R"(%YAML:1.0
@@ -156,14 +269,8 @@ ORBextractor.nFeatures: 1000
 )");
   const CameraCalibration calibration = ReadCameraCalibration(path);
   EXPECT_EQ(calibration.format, CalibrationFormat::kOrbSlam3);
-  const CameraModel& camera = calibration.camera;
-  EXPECT_EQ(camera.fx, 458.654);
-  EXPECT_EQ(camera.cy, 248.375);
-  EXPECT_EQ(camera.width, 752);
-  EXPECT_EQ(camera.rate_hz, 20.0);
-  EXPECT_EQ(camera.model, DistortionModel::kRadTan);
-  EXPECT_EQ(camera.distortion[3], 1.76187114e-05);
-  EXPECT_EQ(camera.distortion[4], 0.0);
+  ExpectEurocCam0(calibration.camera);
+  EXPECT_EQ(calibration.camera.rate_hz, 20.0);
 }
 
 // The File.version "1.0" layout with a fisheye and an IMU extrinsic (!!opencv-matrix).
@@ -225,11 +332,25 @@ TEST(CalibrationTest, WrittenSensorYamlReadsBackEqual) {
   pinhole.model = DistortionModel::kNone;
   pinhole.distortion = {};
   pinhole.rate_hz = 0.0;
+  CameraModel rational = radtan;
+  rational.model = DistortionModel::kRational;
+  rational.distortion = {0.16442580388260605,   -0.9866244487633755, 0.003472548710624201,
+                         -0.002772366031203418, 1.8909532518418533,  0.04108971525533507,
+                         0.06374355932009733,   -0.0679460705265192};
+  CameraModel thin_prism = rational;
+  thin_prism.model = DistortionModel::kThinPrism;
+  thin_prism.distortion[8] = 0.004;
+  thin_prism.distortion[11] = -1.0 / 3000.0;
+  CameraModel tilted = thin_prism;
+  tilted.model = DistortionModel::kTilted;
+  tilted.distortion[12] = 0.03;
+  tilted.distortion[13] = -0.05;
   const Rigid3 body_from_cam(
       Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized())),
       Eigen::Vector3d(0.1, -0.2, 0.3));
   int index = 0;
-  for (const CameraModel& camera : {radtan, radtan_k3, fisheye, pinhole}) {
+  for (const CameraModel& camera :
+       {radtan, radtan_k3, fisheye, pinhole, rational, thin_prism, tilted}) {
     const fs::path path = TempDir() / ("written_" + std::to_string(index++)) / "sensor.yaml";
     fs::create_directories(path.parent_path());
     WriteEuRoCSensorYaml(camera, path, body_from_cam);
@@ -297,7 +418,12 @@ std::vector<MalformedCase> MalformedCases() {
                     "distortion_model: kannala-brandt-6\n"
                     "distortion_coefficients: [-0.28, 0.07, 0.0002, 0.00002]\n",
        "distortion_model: unknown model 'kannala-brandt-6' (expected radial-tangential, "
-       "equidistant or none)"},
+       "equidistant, opencv_rational8, opencv_thin_prism12, opencv_tilted14 or none)"},
+      {"EuRoCRationalCount",
+       kEuRoCHead + "resolution: [752, 480]\nintrinsics: [458.6, 457.3, 367.2, 248.4]\n"
+                    "distortion_model: opencv_rational8\n"
+                    "distortion_coefficients: [-0.28, 0.07, 0.0002, 0.00002, 0.1]\n",
+       "distortion_coefficients: expected 8 numbers, found 5"},
       {"EuRoCNegativeFocalLength",
        kEuRoCHead + "resolution: [752, 480]\nintrinsics: [-458.6, 457.3, 367.2, 248.4]\n"
                     "distortion_model: radial-tangential\n"
@@ -348,9 +474,59 @@ std::vector<MalformedCase> MalformedCases() {
        "camera_matrix.data: expected [fx, 0, cx, 0, fy, cy, 0, 0, 1] (no skew)"},
       {"RosUnknownDistortionModel",
        "image_width: 640\nimage_height: 480\nK: [500, 0, 320, 0, 500, 240, 0, 0, 1]\n"
-       "distortion_model: rational_polynomial\nD: [0, 0, 0, 0, 0, 0, 0, 0]\n",
-       "distortion_model: unknown model 'rational_polynomial' (expected plumb_bob, equidistant "
-       "or none)"},
+       "distortion_model: fov\nD: [0.9]\n",
+       "distortion_model: unknown model 'fov' (expected plumb_bob, rational_polynomial, "
+       "equidistant or none)"},
+      {"RosRationalCount",
+       "image_width: 640\nimage_height: 480\nK: [500, 0, 320, 0, 500, 240, 0, 0, 1]\n"
+       "distortion_model: rational_polynomial\nD: [0.1, 0, 0, 0, 0]\n",
+       "D: expected 8 numbers, found 5"},
+      {"OpenCvDistortionCount",
+       "%YAML:1.0\nimage_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix\n"
+       "  {rows: 3, cols: 3, dt: d, data: [500, 0, 320, 0, 500, 240, 0, 0, 1]}\n"
+       "distortion_coefficients: !!opencv-matrix\n  {rows: 1, cols: 6, dt: d, data: [0.1, 0, 0, "
+       "0, 0, 0]}\n",
+       "distortion_coefficients.data: expected 0, 4, 5, 8, 12 or 14, found 6 numbers"},
+      {"OpenCvMatrixShape",
+       "%YAML:1.0\nimage_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix\n"
+       "  {rows: 2, cols: 3, dt: d, data: [500, 0, 320, 0, 500, 240]}\n",
+       "camera_matrix: expected a 3x3 matrix"},
+      {"OpenCvDataShorterThanShape",
+       "%YAML:1.0\nimage_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix\n"
+       "  {rows: 3, cols: 3, dt: d, data: [500, 0, 320, 0, 500, 240, 0, 0, 1]}\n"
+       "distortion_coefficients: !!opencv-matrix\n  {rows: 1, cols: 5, dt: d, data: [0.1, 0]}\n",
+       "distortion_coefficients.data: expected 5 numbers, found 2"},
+      {"OpenCvMissingHeight",
+       "%YAML:1.0\nimage_width: 640\ncamera_matrix: !!opencv-matrix\n"
+       "  {rows: 3, cols: 3, dt: d, data: [500, 0, 320, 0, 500, 240, 0, 0, 1]}\n",
+       "image_height: missing"},
+      {"OpenCvXmlFocalNotPositive",
+       "<?xml version=\"1.0\"?>\n<opencv_storage>\n<image_width>640</image_width>\n"
+       "<image_height>480</image_height>\n<camera_matrix type_id=\"opencv-matrix\"><rows>3</rows>"
+       "<cols>3</cols><dt>d</dt><data>0. 0. 320. 0. 500. 240. 0. 0. 1.</data></camera_matrix>\n"
+       "</opencv_storage>\n",
+       "camera_matrix.data: focal lengths must be positive, found fx = 0, fy = 500"},
+      {"OpenCvXmlBroken",
+       "<?xml version=\"1.0\"?>\n<opencv_storage>\n<image_width>640</image_width\n",
+       "not valid OpenCV XML: ", true},
+      {"KalibrUnsupportedModel",
+       "cam0:\n  camera_model: omni\n  intrinsics: [0.8, 300, 300, 320, 240]\n",
+       "cam0.camera_model: unsupported model 'omni' (expected pinhole)"},
+      {"KalibrMissingIntrinsics", "cam0:\n  camera_model: pinhole\n  resolution: [640, 480]\n",
+       "cam0.intrinsics: missing"},
+      {"KalibrUnknownDistortionModel",
+       "cam0:\n  camera_model: pinhole\n  intrinsics: [500, 500, 320, 240]\n"
+       "  resolution: [640, 480]\n  distortion_model: fov\n  distortion_coeffs: [0.9]\n",
+       "cam0.distortion_model: unknown model 'fov' (expected radtan, equidistant or none)"},
+      {"KalibrDistortionCount",
+       "cam0:\n  camera_model: pinhole\n  intrinsics: [500, 500, 320, 240]\n"
+       "  resolution: [640, 480]\n  distortion_model: radtan\n  distortion_coeffs: [0.1, 0.2]\n",
+       "cam0.distortion_coeffs: expected 4 to 5 numbers, found 2"},
+      {"KalibrShortMatrixRow",
+       "cam0:\n  camera_model: pinhole\n  intrinsics: [500, 500, 320, 240]\n"
+       "  resolution: [640, 480]\n  distortion_model: none\n  distortion_coeffs: []\n"
+       "  T_cam_imu:\n  - [1, 0, 0, 0]\n  - [0, 1, 0]\n  - [0, 0, 1, 0]\n  - [0, 0, 0, 1]\n",
+       "cam0.T_cam_imu.1: expected 4 numbers, found 3"},
       {"RosDistortionCount",
        "image_width: 640\nimage_height: 480\nK: [500, 0, 320, 0, 500, 240, 0, 0, 1]\n"
        "distortion_model: equidistant\n"
@@ -364,7 +540,8 @@ std::vector<MalformedCase> MalformedCases() {
       {"NotAMap", "just some text\n", "not a camera calibration: expected a YAML map of fields"},
       {"UnknownFormat", "sensor_type: imu\ngyroscope_noise_density: 1.7e-4\n",
        "not a camera calibration: expected EuRoC sensor.yaml (intrinsics), ORB-SLAM3 settings "
-       "(Camera.fx or Camera1.fx) or ROS camera_info (image_width)"},
+       "(Camera.fx or Camera1.fx), ROS camera_info or OpenCV FileStorage (image_width) or "
+       "Kalibr camchain (cam0)"},
   };
 }
 

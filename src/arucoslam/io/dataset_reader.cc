@@ -8,6 +8,7 @@
 #include <cmath>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
+#include <optional>
 #include <sstream>
 
 #include "arucoslam/io/calibration.h"
@@ -103,6 +104,71 @@ CameraCalibration RequireCamera(const DatasetOptions& options, const fs::path& r
   return ReadCameraCalibration(options.camera_path);
 }
 
+// KITTI times.txt: seconds in decimal or exponent notation ("1.038752e-01").
+bool ParseKittiSeconds(const std::string& text, std::int64_t* nanoseconds, double* seconds) {
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), *seconds);
+  if (error != std::errc() || end != text.data() + text.size() || !std::isfinite(*seconds) ||
+      *seconds < 0.0) {
+    return false;
+  }
+  *nanoseconds = std::llround(*seconds * 1e9);
+  return true;
+}
+
+// A KITTI camera from calib.txt: "P<i>: " and the 12 numbers of the rectified 3x4 projection
+// K [I | t]; t places the camera relative to camera 0 (P0 has t = 0). No distortion.
+struct KittiCamera {
+  CameraModel camera;
+  Rigid3 cam0_from_cam;
+};
+
+KittiCamera ReadKittiCamera(const fs::path& path, int camera_index) {
+  RequireFile(path, "KITTI calibration");
+  const std::string key = fmt::format("P{}:", camera_index);
+  std::optional<std::vector<double>> projection;
+  ForEachDataLine(path, [&](int line_number, const std::string& line) {
+    if (!line.starts_with(key)) return;
+    std::istringstream fields(line.substr(key.size()));
+    std::vector<double> values;
+    std::string token;
+    while (fields >> token) {
+      double value = 0.0;
+      const auto [end, error] = std::from_chars(token.data(), token.data() + token.size(), value);
+      if (error != std::errc() || end != token.data() + token.size() || !std::isfinite(value)) {
+        throw InputError(path.string(), fmt::format("line {}: {} expected 12 numbers, found '{}'",
+                                                    line_number, key, token));
+      }
+      values.push_back(value);
+    }
+    if (values.size() != 12) {
+      throw InputError(path.string(), fmt::format("line {}: {} expected 12 numbers, found {}",
+                                                  line_number, key, values.size()));
+    }
+    projection = values;
+  });
+  if (!projection) throw InputError(path.string(), fmt::format("{} missing", key));
+  const std::vector<double>& p = *projection;
+  KittiCamera kitti;
+  CameraModel& camera = kitti.camera;
+  camera.fx = p[0];
+  camera.cx = p[2];
+  camera.fy = p[5];
+  camera.cy = p[6];
+  if (!(camera.fx > 0.0) || !(camera.fy > 0.0) || p[1] != 0.0 || p[4] != 0.0 || p[8] != 0.0 ||
+      p[9] != 0.0 || p[10] != 1.0) {
+    throw InputError(path.string(),
+                     fmt::format("{} expected a rectified projection [fx 0 cx tx; 0 fy cy ty; "
+                                 "0 0 1 tz] with positive focal lengths",
+                                 key));
+  }
+  // cam_from_cam0 translation = K^-1 (p3, p7, p11).
+  const double tz = p[11];
+  const Eigen::Vector3d cam_from_cam0((p[3] - camera.cx * tz) / camera.fx,
+                                      (p[7] - camera.cy * tz) / camera.fy, tz);
+  kitti.cam0_from_cam = Rigid3(Eigen::Quaterniond::Identity(), -cam_from_cam0);
+  return kitti;
+}
+
 }  // namespace
 
 std::string DatasetLayoutName(DatasetLayout layout) {
@@ -115,6 +181,8 @@ std::string DatasetLayoutName(DatasetLayout layout) {
       return "tum";
     case DatasetLayout::kImageFolder:
       return "images";
+    case DatasetLayout::kKitti:
+      return "kitti";
   }
   return "unknown";
 }
@@ -145,15 +213,25 @@ Dataset Dataset::Open(const fs::path& root, const DatasetOptions& options) {
       layout = DatasetLayout::kTumRgbd;
     } else if (fs::exists(root / "mav0")) {
       layout = DatasetLayout::kEuroc;  // EuRoC with something missing: say what
+    } else if (fs::exists(root / "times.txt") || fs::exists(root / "calib.txt")) {
+      layout = DatasetLayout::kKitti;
     } else {
       layout = DatasetLayout::kImageFolder;
     }
   }
   Dataset dataset = layout == DatasetLayout::kEuroc     ? OpenEuroc(root, options)
                     : layout == DatasetLayout::kTumRgbd ? OpenTum(root, options)
+                    : layout == DatasetLayout::kKitti   ? OpenKitti(root, options)
                                                         : OpenImageFolder(root, options);
   dataset.layout_ = layout;
   dataset.root_ = root;
+  if (dataset.frames_.empty() && options.layout == DatasetLayout::kAuto &&
+      layout == DatasetLayout::kImageFolder) {
+    throw InputError(root.string(),
+                     "no frames: no known sequence layout (expected mav0/cam0/data.csv for "
+                     "EuRoC, rgb.txt for TUM RGB-D, times.txt + calib.txt + image_0/ for KITTI, "
+                     "or image files)");
+  }
   if (dataset.frames_.empty()) {
     throw InputError(root.string(),
                      fmt::format("the {} sequence has no frames", DatasetLayoutName(layout)));
@@ -247,6 +325,84 @@ Dataset Dataset::OpenImageFolder(const fs::path& root, const DatasetOptions& opt
     frame.timestamp_ns = std::llround(frame.timestamp_s * 1e9);
     frame.image_path = image;
     dataset.frames_.push_back(frame);
+  }
+  return dataset;
+}
+
+Dataset Dataset::OpenKitti(const fs::path& root, const DatasetOptions& options) {
+  Dataset dataset;
+  const int camera_index =
+      fs::is_directory(root / "image_0") || !fs::is_directory(root / "image_2") ? 0 : 2;
+  const fs::path image_folder = root / fmt::format("image_{}", camera_index);
+  RequireDirectory(image_folder, "KITTI image folder (image_0 or image_2)");
+  const fs::path times_path = root / "times.txt";
+  RequireFile(times_path, "KITTI timestamps");
+  std::vector<double> times;
+  ForEachDataLine(times_path, [&](int line_number, const std::string& line) {
+    std::int64_t nanoseconds = 0;
+    double seconds = 0.0;
+    if (!ParseKittiSeconds(line, &nanoseconds, &seconds)) {
+      throw InputError(
+          times_path.string(),
+          fmt::format("line {}: expected a time in seconds, found '{}'", line_number, line));
+    }
+    times.push_back(seconds);
+  });
+  Rigid3 cam0_from_cam;
+  if (options.camera_path.empty()) {
+    const KittiCamera kitti = ReadKittiCamera(root / "calib.txt", camera_index);
+    dataset.camera_ = kitti.camera;
+    cam0_from_cam = kitti.cam0_from_cam;
+  } else {
+    dataset.camera_ = ReadCameraCalibration(options.camera_path).camera;
+  }
+  dataset.body_from_cam_ = cam0_from_cam;
+  std::vector<fs::path> images;
+  for (const fs::directory_entry& entry : fs::directory_iterator(image_folder)) {
+    if (entry.is_regular_file() && IsImageFile(entry.path())) images.push_back(entry.path());
+  }
+  std::sort(images.begin(), images.end());
+  for (const fs::path& image : images) {
+    std::int64_t number = 0;
+    if (!ParseInt64(image.stem().string(), &number)) {
+      throw InputError(image.string(), "expected a KITTI frame number as the file name (000042)");
+    }
+    if (number >= static_cast<std::int64_t>(times.size())) {
+      throw InputError(times_path.string(),
+                       fmt::format("{} lines, but image {} needs line {}", times.size(),
+                                   image.filename().string(), number + 1));
+    }
+    DatasetFrame frame;
+    frame.index = dataset.frames_.size();
+    frame.timestamp_s = times[number];
+    frame.timestamp_ns = std::llround(frame.timestamp_s * 1e9);
+    frame.image_path = image;
+    dataset.frames_.push_back(frame);
+    RequireIncreasing(dataset.frames_, times_path, static_cast<int>(number) + 1);
+  }
+  // calib.txt gives no image size: the calibrated camera takes the first image's.
+  if (options.camera_path.empty() && !images.empty()) {
+    const cv::Mat first = cv::imread(images.front().string(), cv::IMREAD_GRAYSCALE);
+    if (first.empty()) throw InputError(images.front().string(), "cannot read the image");
+    dataset.camera_.width = first.cols;
+    dataset.camera_.height = first.rows;
+  }
+  fs::path truth = options.ground_truth_path;
+  if (truth.empty()) {
+    const fs::path standard =
+        root.parent_path().parent_path() / "poses" / (root.filename().string() + ".txt");
+    if (fs::is_regular_file(standard)) truth = standard;
+  }
+  if (!truth.empty()) {
+    const Trajectory world_from_cam0 = ReadKittiTrajectory(truth);
+    if (world_from_cam0.size() > times.size()) {
+      throw InputError(truth.string(),
+                       fmt::format("{} poses but {} has {} lines", world_from_cam0.size(),
+                                   times_path.string(), times.size()));
+    }
+    for (std::size_t i = 0; i < world_from_cam0.size(); ++i) {
+      dataset.ground_truth_.Add(times[i], world_from_cam0.poses[i] * cam0_from_cam);
+    }
   }
   return dataset;
 }

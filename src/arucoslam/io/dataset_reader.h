@@ -1,5 +1,6 @@
-// Dataset: one interface over the image sequences `run` reads (EuRoC layout, TUM RGB-D
+// Dataset: the image sequences stored as files (EuRoC layout, TUM RGB-D folder, KITTI odometry
 // folder, plain image folder): the frames in time order, the camera and optional ground truth.
+// io/frame_source.h streams these and videos and live cameras through one interface.
 #pragma once
 
 #include <cstddef>
@@ -17,10 +18,14 @@
 namespace arucoslam {
 
 enum class DatasetLayout {
-  kAuto,         // EuRoC when mav0/cam0/data.csv exists, TUM when rgb.txt exists, else images
+  kAuto,         // EuRoC when mav0/cam0/data.csv exists, TUM when rgb.txt exists, KITTI when
+                 // times.txt or calib.txt exists, else images
   kEuroc,        // SEQ/mav0/cam0/{data.csv,data/,sensor.yaml}, optional ground truth
   kTumRgbd,      // SEQ/rgb.txt (+ groundtruth.txt); camera from DatasetOptions::camera_path
   kImageFolder,  // SEQ/*.{png,jpg,jpeg,pgm,bmp,tif,tiff} sorted by name; timestamps from a rate
+  kKitti,        // KITTI odometry: SEQ/image_0/NNNNNN.png (else image_2/), SEQ/times.txt,
+                 // SEQ/calib.txt (P0, or P2 for image_2); ground truth from
+                 // SEQ/../../poses/<SEQ name>.txt or DatasetOptions::ground_truth_path
 };
 
 std::string DatasetLayoutName(DatasetLayout layout);
@@ -33,6 +38,9 @@ struct DatasetOptions {
   // Image folder: frame rate in Hz that gives the timestamps (index / rate). 0: the camera
   // file's rate_hz, or 20 Hz when that is unknown too.
   double rate_hz = 0.0;
+  // KITTI: a poses file (12 numbers per line, world_from_cam0, one line per times.txt line)
+  // to use as ground truth instead of SEQ/../../poses/<SEQ name>.txt. Empty: that one if present.
+  std::filesystem::path ground_truth_path;
 
   bool Check() const { return rate_hz >= 0.0; }
 };
@@ -83,6 +91,7 @@ class Dataset {
   static Dataset OpenEuroc(const std::filesystem::path& root, const DatasetOptions& options);
   static Dataset OpenTum(const std::filesystem::path& root, const DatasetOptions& options);
   static Dataset OpenImageFolder(const std::filesystem::path& root, const DatasetOptions& options);
+  static Dataset OpenKitti(const std::filesystem::path& root, const DatasetOptions& options);
 };
 
 // Loads an image as 8-bit grey and checks its size against `camera` (both throw InputError).

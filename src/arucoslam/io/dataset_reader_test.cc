@@ -1,5 +1,6 @@
 #include "arucoslam/io/dataset_reader.h"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -7,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "arucoslam/io/calibration.h"
+#include "arucoslam/io/trajectory_io.h"
 #include "arucoslam/util/error.h"
 
 namespace arucoslam {
@@ -217,6 +219,91 @@ TEST_F(DatasetReaderTest, ImageFolderSortedWithRate) {
   const fs::path empty = folder_ / "empty";
   fs::create_directories(empty);
   ExpectInputError([&] { Dataset::Open(empty, options); }, "empty", "no frames");
+  ExpectInputError([&] { Dataset::Open(empty, options); }, "empty", "no known sequence layout");
+}
+
+const fs::path kKitti07 = fs::path(ARUCOSLAM_TEST_DATA_DIR) / "kitti07_first160";
+
+TEST_F(DatasetReaderTest, KittiOdometryRealClip) {
+  if (!fs::exists(kKitti07)) GTEST_SKIP() << "test data folder missing: " << kKitti07;
+  const Dataset dataset = Dataset::Open(kKitti07 / "original");
+  EXPECT_EQ(dataset.layout(), DatasetLayout::kKitti);
+  ASSERT_EQ(dataset.size(), 160u);
+  const CameraModel& camera = dataset.camera();
+  EXPECT_EQ(camera.width, 1226);
+  EXPECT_EQ(camera.height, 370);
+  EXPECT_EQ(camera.fx, 707.0912);
+  EXPECT_EQ(camera.fy, 707.0912);
+  EXPECT_EQ(camera.cx, 601.8873);
+  EXPECT_EQ(camera.cy, 183.1104);
+  EXPECT_EQ(camera.model, DistortionModel::kNone);
+  EXPECT_EQ(dataset.frame(0).timestamp_s, 0.0);
+  EXPECT_EQ(dataset.frame(1).timestamp_s, 0.1038752);
+  EXPECT_EQ(dataset.frame(159).image_path.filename(), "000159.png");
+  EXPECT_FALSE(dataset.has_ground_truth());  // no poses/07.txt two folders up
+  EXPECT_EQ(dataset.LoadImage(159).cols, 1226);
+
+  DatasetOptions options;
+  options.ground_truth_path = kKitti07 / "poses_07_first160_kitti.txt";
+  const Dataset with_truth = Dataset::Open(kKitti07 / "original", options);
+  ASSERT_EQ(with_truth.ground_truth().size(), 160u);
+  EXPECT_EQ(with_truth.ground_truth().timestamps[1], 0.1038752);
+  EXPECT_TRUE(with_truth.ground_truth().poses[0].translation.isZero(1e-9));
+  // The clip's TUM copy of the same poses (timestamps offset by 1e9 s).
+  const Trajectory tum = ReadTumTrajectory(kKitti07 / "groundtruth_first160_tum.txt");
+  ASSERT_EQ(tum.size(), 160u);
+  EXPECT_LT((with_truth.ground_truth().poses[159].translation - tum.poses[159].translation).norm(),
+            1e-5);
+}
+
+// A KITTI folder of the standard layout (sequences/NN beside poses/NN.txt) with the colour
+// camera: P2's translation puts camera 2 beside camera 0 in the ground truth.
+TEST_F(DatasetReaderTest, KittiStandardLayoutColourCameraAndErrors) {
+  const fs::path seq = folder_ / "dataset" / "sequences" / "04";
+  fs::create_directories(seq / "image_2");
+  for (int i = 0; i < 3; ++i) {
+    cv::imwrite((seq / "image_2" / fmt::format("{:06d}.png", i)).string(),
+                cv::Mat(48, 64, CV_8UC3, cv::Scalar(i, 2 * i, 3 * i)));
+  }
+  WriteText(seq / "times.txt", "0.000000e+00\n1.000000e-01\n2.000000e-01\n3.000000e-01\n");
+  const std::string p0 = "5.0e+01 0 3.15e+01 0 0 5.0e+01 2.35e+01 0 0 0 1 0";
+  // Camera 2 sits 0.06 m left of camera 0: t = (0.06, 0, 0), P2[3] = fx * 0.06 = 3.
+  WriteText(seq / "calib.txt", "P0: " + p0 + "\nP1: " + p0 +
+                                   "\nP2: 5.0e+01 0 3.15e+01 3 0 "
+                                   "5.0e+01 2.35e+01 0 0 0 1 0\nP3: " +
+                                   p0 + "\nTr: " + p0 + "\n");
+  WriteText(folder_ / "dataset" / "poses" / "04.txt",
+            "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 1 0 0 0 0 1 1\n1 0 0 0 0 1 0 0 0 0 1 2\n");
+  const Dataset dataset = Dataset::Open(seq);
+  EXPECT_EQ(dataset.layout(), DatasetLayout::kKitti);
+  ASSERT_EQ(dataset.size(), 3u);
+  EXPECT_EQ(dataset.camera().width, 64);
+  EXPECT_EQ(dataset.camera().cx, 31.5);
+  EXPECT_DOUBLE_EQ(dataset.frame(2).timestamp_s, 0.2);
+  ASSERT_EQ(dataset.ground_truth().size(), 3u);
+  EXPECT_TRUE(dataset.ground_truth().poses[1].translation.isApprox(Eigen::Vector3d(-0.06, 0, 1)))
+      << dataset.ground_truth().poses[1].translation.transpose();
+
+  WriteText(seq / "times.txt", "0.0\n0.1\n");
+  ExpectInputError([&] { Dataset::Open(seq); }, "times.txt",
+                   "2 lines, but image 000002.png needs line 3");
+  WriteText(seq / "times.txt", "0.0\nsoon\n0.2\n");
+  ExpectInputError([&] { Dataset::Open(seq); }, "times.txt", "line 2: expected a time in seconds");
+  WriteText(seq / "times.txt", "0.0\n0.1\n0.2\n");
+  WriteText(seq / "calib.txt", "P0: " + p0 + "\nP2: 5.0e+01 0 3.15e+01 3 0 5.0e+01 2.35e+01\n");
+  ExpectInputError([&] { Dataset::Open(seq); }, "calib.txt",
+                   "line 2: P2: expected 12 numbers, found 7");
+  WriteText(seq / "calib.txt", "P0: " + p0 + "\n");
+  ExpectInputError([&] { Dataset::Open(seq); }, "calib.txt", "P2: missing");
+  fs::remove(seq / "calib.txt");
+  ExpectInputError([&] { Dataset::Open(seq); }, "calib.txt", "does not exist");
+  // --camera replaces calib.txt.
+  WriteEuRoCSensorYaml(SmallCamera(), folder_ / "camera.yaml");
+  DatasetOptions options;
+  options.camera_path = folder_ / "camera.yaml";
+  EXPECT_EQ(Dataset::Open(seq, options).camera().fx, 50.0);
+  cv::imwrite((seq / "image_2" / "frame.png").string(), cv::Mat(48, 64, CV_8UC3));
+  ExpectInputError([&] { Dataset::Open(seq, options); }, "frame.png", "KITTI frame number");
 }
 
 }  // namespace

@@ -250,7 +250,19 @@ std::vector<double> GetDoubles(ByteReader& in, std::string_view what) {
   return values;
 }
 
-CameraModel GetCamera(ByteReader& in) {
+// Bytes of a stored camera: size, intrinsics, model, distortion, rate.
+constexpr std::size_t CameraBytes(int num_distortion) {
+  return 4 + 4 + 32 + 1 + 8 * num_distortion + 8;
+}
+// Distortion coefficients a camera stores in each version, and the last model it knows.
+int StoredDistortionCount(std::uint32_t version) {
+  return version >= 3 ? kMaxDistortionCoefficients : 5;
+}
+DistortionModel LastStoredModel(std::uint32_t version) {
+  return version >= 3 ? DistortionModel::kTilted : DistortionModel::kEquidistant;
+}
+
+CameraModel GetCamera(ByteReader& in, std::uint32_t version) {
   CameraModel camera;
   camera.width = in.Get<std::int32_t>("camera width");
   camera.height = in.Get<std::int32_t>("camera height");
@@ -258,11 +270,13 @@ CameraModel GetCamera(ByteReader& in) {
     *value = in.Get<double>("camera intrinsics");
   }
   const auto model = in.Get<std::uint8_t>("camera model");
-  if (model > static_cast<std::uint8_t>(DistortionModel::kEquidistant)) {
+  if (model > static_cast<std::uint8_t>(LastStoredModel(version))) {
     throw in.Corrupt(fmt::format("unknown camera model {}", model));
   }
   camera.model = static_cast<DistortionModel>(model);
-  for (double& value : camera.distortion) value = in.Get<double>("camera distortion");
+  for (int i = 0; i < StoredDistortionCount(version); ++i) {
+    camera.distortion[i] = in.Get<double>("camera distortion");
+  }
   camera.rate_hz = in.Get<double>("camera rate");
   return camera;
 }
@@ -381,7 +395,7 @@ void RequireIncreasing(const ByteReader& in, Id previous, Id id, std::string_vie
   }
 }
 
-StoredMap ParsePayload(ByteReader& in) {
+StoredMap ParsePayload(ByteReader& in, std::uint32_t version) {
   StoredMap stored;
   in.ExpectTag("META");
   const auto flags = in.Get<std::uint32_t>("map flags");
@@ -390,8 +404,9 @@ StoredMap ParsePayload(ByteReader& in) {
   }
   stored.info.world_aligned = (flags & kWorldAlignedFlag) != 0;
   in.ExpectTag("CAMS");
-  std::vector<CameraModel> cameras(in.GetCount(89, "cameras"));
-  for (CameraModel& camera : cameras) camera = GetCamera(in);
+  std::vector<CameraModel> cameras(
+      in.GetCount(CameraBytes(StoredDistortionCount(version)), "cameras"));
+  for (CameraModel& camera : cameras) camera = GetCamera(in, version);
   in.ExpectTag("KFRM");
   stored.first_keyframe = in.GetId<KeyframeId>("first keyframe");
   stored.keyframes.resize(in.GetCount(100, "keyframes"));
@@ -431,8 +446,9 @@ std::uint64_t ReadLittleEndian(std::string_view bytes, std::size_t offset, std::
   return value;
 }
 
-// Checks magic, byte order, version, size and checksum; returns the payload.
-std::string_view CheckEnvelope(std::string_view bytes, const std::string& source) {
+// Checks magic, byte order, version, size and checksum; returns the payload and sets `version`.
+std::string_view CheckEnvelope(std::string_view bytes, const std::string& source,
+                               std::uint32_t* version) {
   const std::size_t size = bytes.size();
   const std::size_t magic_bytes = std::min(size, kMagic.size());
   if (bytes.substr(0, magic_bytes) != kMagic.substr(0, magic_bytes)) {
@@ -449,10 +465,10 @@ std::string_view CheckEnvelope(std::string_view bytes, const std::string& source
                                          "expected {:#010x}",
                                          marker, kByteOrderMarker));
   }
-  const auto version = ReadLittleEndian(bytes, 20, 4);
-  if (version != kMapFormatVersion) {
-    throw InputError(source, fmt::format("map format version {}, this build reads {}", version,
-                                         kMapFormatVersion));
+  *version = static_cast<std::uint32_t>(ReadLittleEndian(bytes, 20, 4));
+  if (*version < kOldestMapFormatVersion || *version > kMapFormatVersion) {
+    throw InputError(source, fmt::format("map format version {}, this build reads {} to {}",
+                                         *version, kOldestMapFormatVersion, kMapFormatVersion));
   }
   const std::uint64_t payload_bytes = ReadLittleEndian(bytes, 24, 8);
   const std::uint64_t limit = std::numeric_limits<std::uint64_t>::max() - kHeaderBytes - 8;
@@ -612,9 +628,10 @@ std::string SerializeMap(const MapData& data, const MapFileInfo& info) {
 }
 
 MapData DeserializeMap(std::string_view bytes, const std::string& source, MapFileInfo* info) {
-  const std::string_view payload = CheckEnvelope(bytes, source);
+  std::uint32_t version = 0;
+  const std::string_view payload = CheckEnvelope(bytes, source, &version);
   ByteReader reader(payload, source, kHeaderBytes);
-  StoredMap stored = ParsePayload(reader);
+  StoredMap stored = ParsePayload(reader, version);
   MapData data;
   AddEntities(stored, data, source);
   RestoreSpanningTree(stored, data, source);
@@ -624,8 +641,7 @@ MapData DeserializeMap(std::string_view bytes, const std::string& source, MapFil
   return data;
 }
 
-void SaveMapFile(const MapData& data, const std::filesystem::path& path,
-                 const MapFileInfo& info) {
+void SaveMapFile(const MapData& data, const std::filesystem::path& path, const MapFileInfo& info) {
   WriteTextFileAtomically(path, SerializeMap(data, info));
 }
 

@@ -12,7 +12,7 @@
 
 namespace arucoslam {
 
-// Layout of format version 2 (all numbers little-endian, doubles as IEEE-754 bit patterns,
+// Layout of format version 3 (all numbers little-endian, doubles as IEEE-754 bit patterns,
 // so poses and positions load back bit-exact):
 //   header  : 16 magic bytes "ARUCOSLAM-MAP\r\n\x1a", u32 endianness marker 0x01020304,
 //             u32 format version, u64 payload size in bytes;
@@ -26,8 +26,12 @@ namespace arucoslam {
 // Covisibility weights are not stored: by definition they count the points two keyframes
 // share, so loading rebuilds them exactly from the observations. The spanning tree depends
 // on the map's history and is stored. Ids are kept; the loaded map hands out new ids above
-// the largest loaded one. Version 1 (no "META") is refused like any other version.
-inline constexpr std::uint32_t kMapFormatVersion = 2;
+// the largest loaded one. A camera is u32 width, height, 4 doubles fx fy cx cy, u8 distortion
+// model, 14 doubles of distortion (OpenCV's order), double rate. Version 2 (still read) stored 5
+// distortion doubles and knew the models up to equidistant; version 1 (no "META") is refused
+// like any other version.
+inline constexpr std::uint32_t kMapFormatVersion = 3;
+inline constexpr std::uint32_t kOldestMapFormatVersion = 2;
 
 // What a map file records about its map beyond keyframes and points.
 struct MapFileInfo {
@@ -40,7 +44,8 @@ struct MapFileInfo {
 std::string SerializeMap(const MapData& data, const MapFileInfo& info = {});
 
 // Decodes the bytes of a map file; `source` names them in errors. Throws InputError(source,
-// ...) for: wrong magic ("not an arucoslam map"), another format version, a truncated file
+// ...) for: wrong magic ("not an arucoslam map"), a format version outside
+// kOldestMapFormatVersion..kMapFormatVersion, a truncated file
 // ("ends after N bytes, expected M"), trailing bytes, a checksum mismatch, or content that is
 // inconsistent (unknown ids, broken spanning tree, observations not mirrored). `info`, when
 // given, receives the file's MapFileInfo.
@@ -52,8 +57,7 @@ MapData DeserializeMap(std::string_view bytes, const std::string& source,
 void SaveMapFile(const MapData& data, const std::filesystem::path& path,
                  const MapFileInfo& info = {});
 // Same for a shared Map: serialises under one read lock, writes after releasing it.
-void SaveMapFile(const Map& map, const std::filesystem::path& path,
-                 const MapFileInfo& info = {});
+void SaveMapFile(const Map& map, const std::filesystem::path& path, const MapFileInfo& info = {});
 
 // Reads a map file; throws InputError naming `path` when it is missing or bad (see above).
 MapData LoadMapFile(const std::filesystem::path& path, MapFileInfo* info = nullptr);

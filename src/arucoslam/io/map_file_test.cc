@@ -321,12 +321,60 @@ TEST(MapFileTest, WrongMagicIsNotAMap) {
 
 TEST(MapFileTest, OtherVersionIsNamed) {
   std::string bytes = SerializeMap(BuildTestMap(3, 20, 30, 5));
-  ASSERT_EQ(bytes[20], 2);  // version field (u32 little-endian after magic and byte order)
-  bytes[20] = 3;
-  EXPECT_EQ(ErrorOf(bytes), "map format version 3, this build reads 2");
-  // A file of the previous version (no world-alignment flags) is refused the same way.
+  ASSERT_EQ(bytes[20], 3);  // version field (u32 little-endian after magic and byte order)
+  bytes[20] = 4;
+  EXPECT_EQ(ErrorOf(bytes), "map format version 4, this build reads 2 to 3");
+  // A file of version 1 (no world-alignment flags) is refused the same way.
   bytes[20] = 1;
-  EXPECT_EQ(ErrorOf(bytes), "map format version 1, this build reads 2");
+  EXPECT_EQ(ErrorOf(bytes), "map format version 1, this build reads 2 to 3");
+}
+
+// The bytes version 2 wrote for the same map: cameras with 5 distortion doubles instead of 14
+// (the map's cameras must not use the other 9).
+std::string AsVersion2(const std::string& version3) {
+  constexpr std::size_t kCamerasAt = 32 + 8 + 4;  // header, META section, CAMS tag
+  constexpr std::size_t kPrefix = 4 + 4 + 32 + 1 + 5 * 8, kDropped = 9 * 8, kSuffix = 8;
+  EXPECT_EQ(version3.substr(kCamerasAt - 4, 4), "CAMS");
+  std::uint32_t count = 0;
+  std::memcpy(&count, version3.data() + kCamerasAt, 4);
+  std::string bytes = version3.substr(0, kCamerasAt + 4);
+  std::size_t at = kCamerasAt + 4;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    EXPECT_EQ(version3.substr(at + kPrefix, kDropped), std::string(kDropped, '\0'));
+    bytes += version3.substr(at, kPrefix) + version3.substr(at + kPrefix + kDropped, kSuffix);
+    at += kPrefix + kDropped + kSuffix;
+  }
+  bytes += version3.substr(at);
+  bytes[20] = 2;
+  PutLittleEndian64(bytes, 24, bytes.size() - 32 - 8);
+  return Resign(bytes);
+}
+
+TEST(MapFileTest, Version2FilesStillLoad) {
+  const MapData original = BuildTestMap(5, 30, 60, 12);
+  const std::string version2 = AsVersion2(SerializeMap(original));
+  ASSERT_LT(version2.size(), SerializeMap(original).size());
+  const MapData loaded = DeserializeMap(version2, "old.map");
+  ExpectMapsEqual(original, loaded);
+  // Saving writes the current version, which loads back equal.
+  ExpectMapsEqual(original, DeserializeMap(SerializeMap(loaded), "new.map"));
+}
+
+TEST(MapFileTest, EveryDistortionModelRoundTrips) {
+  MapData original;
+  std::mt19937 random(13);
+  for (const DistortionModel model :
+       {DistortionModel::kNone, DistortionModel::kRadTan, DistortionModel::kEquidistant,
+        DistortionModel::kRational, DistortionModel::kThinPrism, DistortionModel::kTilted}) {
+    CameraModel camera = TestCamera(model);
+    camera.distortion = {};
+    for (int i = 0; i < NumDistortionCoefficients(model); ++i)
+      camera.distortion[i] = 0.01 * (i + 1);
+    ASSERT_TRUE(camera.Check()) << DistortionModelName(model);
+    original.AddKeyframe(RandomKeyframe(5, camera, random));
+  }
+  const MapData loaded = DeserializeMap(SerializeMap(original), "test.map");
+  ExpectMapsEqual(original, loaded);
 }
 
 TEST(MapFileTest, WorldAlignmentFlagRoundTrips) {

@@ -27,11 +27,13 @@ std::string FormatSlamStatsJson(const SlamRunStats& stats) {
   json["layout"] = stats.layout;
   json["blocking"] = stats.blocking;
   json["markers"] = stats.markers;
+  json["interrupted"] = stats.interrupted;
   json["frames"] = {
       {"total", stats.frames},
       {"tracked", stats.frames_tracked},
       {"lost", stats.frames_lost},
       {"left_out", stats.inconsistent_poses},
+      {"dropped", stats.frames_dropped},
       {"tracked_fraction",
        stats.frames > 0 ? static_cast<double>(stats.frames_tracked) / stats.frames : 0.0}};
   json["tracking"] = {{"losses", stats.losses},
@@ -47,11 +49,11 @@ std::string FormatSlamStatsJson(const SlamRunStats& stats) {
                  {"refined_frame_poses", stats.refined_frame_poses},
                  {"yielded_bundle_adjustments", stats.yielded_bundle_adjustments}};
   if (stats.markers) {
-    json["marker_locations"] = {{"frames_with_fix", stats.marker_fix_frames},
-                                {"disambiguated_by_motion", stats.marker_disambiguations},
-                                {"disambiguated_by_map_rotation",
-                                 stats.map_rotation_disambiguations},
-                                {"marker_only_poses", stats.marker_only_poses}};
+    json["marker_locations"] = {
+        {"frames_with_fix", stats.marker_fix_frames},
+        {"disambiguated_by_motion", stats.marker_disambiguations},
+        {"disambiguated_by_map_rotation", stats.map_rotation_disambiguations},
+        {"marker_only_poses", stats.marker_only_poses}};
     json["marker_fusion"] = {{"world_alignments", stats.world_alignments},
                              {"drift_corrections", stats.marker_drift_corrections},
                              {"whole_map_adjustments", stats.whole_map_marker_adjustments},

@@ -18,14 +18,16 @@ namespace arucoslam {
 // What stats.json records about a run.
 struct SlamRunStats {
   std::string dataset;  // the sequence's path
-  std::string layout;   // DatasetLayoutName
+  std::string layout;   // FrameSource::layout(): euroc, tum, kitti, images, video, camera
   bool blocking = true;
   bool markers = false;  // whether a marker map was used
   int frames = 0;
   int frames_tracked = 0;  // frames with a pose
   int frames_lost = 0;
   int inconsistent_poses = 0;  // tracked, left out of the trajectory: off their keyframes
-  int losses = 0;          // transitions tracking -> lost
+  int frames_dropped = 0;      // live camera: captured but never processed (the SLAM was busy)
+  bool interrupted = false;    // the run stopped early on request (Ctrl-C)
+  int losses = 0;              // transitions tracking -> lost
   int relocalisations = 0;
   int loops_closed = 0;
   int global_bundle_adjustments = 0;  // applied after loop closures
@@ -33,9 +35,9 @@ struct SlamRunStats {
   int initializations = 0;
   int resets = 0;
   int keyframes_inserted = 0;
-  int keyframes = 0;   // in the final map
-  int map_points = 0;  // in the final map
-  int refined_frame_poses = 0;  // frames re-optimised against the final map
+  int keyframes = 0;                   // in the final map
+  int map_points = 0;                  // in the final map
+  int refined_frame_poses = 0;         // frames re-optimised against the final map
   int yielded_bundle_adjustments = 0;  // threaded: local BAs ended early for a waiting keyframe
   // With a marker map: frames with a usable marker location, of which one ambiguous
   // marker settled by the motion prediction, and frames whose pose came from markers alone.
@@ -61,7 +63,8 @@ struct SlamRunStats {
 
 // ASCII PLY with one vertex (x y z, double) per point.
 std::string FormatPlyPoints(const std::vector<Eigen::Vector3d>& points);
-// stats.json text: {"format": "arucoslam.stats/1", "dataset", "frames": {..., "left_out"},
+// stats.json text: {"format": "arucoslam.stats/1", "dataset", "layout", "interrupted",
+// "frames": {..., "left_out", "dropped"},
 // "tracking": {"losses", "relocalisations", ...}, "map": {..., "loops_closed",
 // "global_bundle_adjustments", "refined_frame_poses", "yielded_bundle_adjustments"}, with markers
 // "marker_locations":

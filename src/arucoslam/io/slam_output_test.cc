@@ -1,7 +1,6 @@
 #include "arucoslam/io/slam_output.h"
 
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <sstream>
@@ -70,6 +69,8 @@ TEST(SlamOutput, WritesFourFilesThatReadBack) {
   EXPECT_NE(json.find("\"refined_frame_poses\": 17"), std::string::npos);
   EXPECT_NE(json.find("\"yielded_bundle_adjustments\": 9"), std::string::npos);
   EXPECT_NE(json.find("\"left_out\": 5"), std::string::npos);
+  EXPECT_NE(json.find("\"dropped\": 0"), std::string::npos);
+  EXPECT_NE(json.find("\"interrupted\": false"), std::string::npos);
   EXPECT_NE(json.find("\"disambiguated_by_map_rotation\": 3"), std::string::npos);
   EXPECT_NE(ReadTextFile(dir / "map.ply").find("element vertex 1"), std::string::npos);
   std::filesystem::remove_all(dir);
