@@ -4,7 +4,7 @@
 #include <cmath>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
-#include <queue>
+#include <mutex>
 #include <stdexcept>
 
 #include "arucoslam/feature/quadtree_spread.h"
@@ -29,17 +29,37 @@ std::vector<int> FeaturesPerLevel(const OrbExtractorOptions& options) {
   return counts;
 }
 
-std::vector<cv::Mat> BuildPyramid(const cv::Mat& image, const ScalePyramid& pyramid) {
-  std::vector<cv::Mat> levels(pyramid.num_levels);
-  levels[0] = image;
-  for (int level = 1; level < pyramid.num_levels; ++level) {
-    const cv::Size size(static_cast<int>(std::lround(image.cols * pyramid.inverse_scales[level])),
-                        static_cast<int>(std::lround(image.rows * pyramid.inverse_scales[level])));
-    if (size.width < 1 || size.height < 1) break;
-    cv::resize(levels[level - 1], levels[level], size, 0.0, 0.0, cv::INTER_LINEAR);
+// The pyramid's images, each built from the one above it when first asked for, so that the
+// threads can start on the large levels before the small ones exist.
+class LazyPyramid {
+ public:
+  LazyPyramid(const cv::Mat& image, const ScalePyramid& pyramid)
+      : pyramid_(pyramid), levels_(pyramid.num_levels) {
+    levels_[0] = image;
   }
-  return levels;
-}
+
+  // Level `level`'s image; empty when the level would be smaller than one pixel.
+  const cv::Mat& Level(int level) {
+    if (level == 0) return levels_[0];
+    std::lock_guard<std::mutex> lock(mutex_);
+    const cv::Mat& image = levels_[0];
+    for (; built_ < level; ++built_) {
+      const int next = built_ + 1;
+      const cv::Size size(
+          static_cast<int>(std::lround(image.cols * pyramid_.inverse_scales[next])),
+          static_cast<int>(std::lround(image.rows * pyramid_.inverse_scales[next])));
+      if (size.width < 1 || size.height < 1 || levels_[built_].empty()) continue;
+      cv::resize(levels_[built_], levels_[next], size, 0.0, 0.0, cv::INTER_LINEAR);
+    }
+    return levels_[level];
+  }
+
+ private:
+  const ScalePyramid& pyramid_;
+  std::vector<cv::Mat> levels_;
+  std::mutex mutex_;
+  int built_ = 0;  // levels [0, built_] exist (or are known to be empty)
+};
 
 // FAST corners inside [margin, cols - margin) x [margin, rows - margin) of one level: the
 // initial threshold over the whole region, the low one in grid cells left empty.
@@ -141,7 +161,7 @@ bool OrbExtractorOptions::Check() const {
   return num_features > 0 && num_levels >= 1 && num_levels <= 32 && scale_factor > 1.0 &&
          initial_fast_threshold > 0 && min_fast_threshold > 0 &&
          min_fast_threshold <= initial_fast_threshold && cell_size_px >= 8 &&
-         edge_margin_px >= kOrientationPatchRadius + 1;
+         edge_margin_px >= kOrientationPatchRadius + 1 && num_threads >= 1 && num_threads <= 64;
 }
 
 OrbExtractor::OrbExtractor(const OrbExtractorOptions& options)
@@ -150,6 +170,41 @@ OrbExtractor::OrbExtractor(const OrbExtractorOptions& options)
       features_per_level_(FeaturesPerLevel(options)),
       pattern_(BriefPattern::Generate()) {
   if (!options_.Check()) throw std::invalid_argument("OrbExtractorOptions: invalid values");
+  if (options_.num_threads > 1) pool_ = std::make_unique<ThreadPool>(options_.num_threads);
+}
+
+OrbExtractor::~OrbExtractor() = default;
+OrbExtractor::OrbExtractor(OrbExtractor&&) noexcept = default;
+OrbExtractor& OrbExtractor::operator=(OrbExtractor&&) noexcept = default;
+
+OrbExtractor::LevelFeatures OrbExtractor::ExtractLevel(const cv::Mat& level_image, int level,
+                                                       cv::Size image_size) const {
+  LevelFeatures result;
+  std::vector<cv::KeyPoint> corners = DetectCorners(level_image, options_);
+  corners = SpreadWithQuadtree(corners, cv::Rect(0, 0, level_image.cols, level_image.rows),
+                               features_per_level_[level]);
+  if (corners.empty()) return result;
+  cv::Mat blurred;
+  cv::GaussianBlur(level_image, blurred, cv::Size(7, 7), 2.0, 2.0, cv::BORDER_REFLECT_101);
+  result.descriptors.create(static_cast<int>(corners.size()), kOrbDescriptorBytes, CV_8U);
+  const std::vector<int> half_widths = CircleHalfWidths(kOrientationPatchRadius);
+  const double sx = static_cast<double>(image_size.width) / level_image.cols;
+  const double sy = static_cast<double>(image_size.height) / level_image.rows;
+  for (std::size_t i = 0; i < corners.size(); ++i) {
+    cv::KeyPoint& kp = corners[i];
+    kp.angle =
+        IntensityCentroidAngle(level_image, cvRound(kp.pt.x), cvRound(kp.pt.y), half_widths);
+    Describe(blurred, kp, pattern_, result.descriptors.ptr<std::uint8_t>(static_cast<int>(i)));
+    // Pixel centres map as (x + 0.5) * scale - 0.5 between levels.
+    kp.pt.x = static_cast<float>((kp.pt.x + 0.5) * sx - 0.5);
+    kp.pt.y = static_cast<float>((kp.pt.y + 0.5) * sy - 0.5);
+    kp.octave = level;
+    kp.size = static_cast<float>(2 * kOrientationPatchRadius + 1) *
+              static_cast<float>(pyramid_.scales[level]);
+    kp.class_id = -1;
+  }
+  result.keypoints = std::move(corners);
+  return result;
 }
 
 OrbFeatures OrbExtractor::Extract(const cv::Mat& image) const {
@@ -160,41 +215,29 @@ OrbFeatures OrbExtractor::Extract(const cv::Mat& image) const {
   features.pyramid = pyramid_;
   features.image_width = image.cols;
   features.image_height = image.rows;
-  const std::vector<cv::Mat> levels = BuildPyramid(image, pyramid_);
-  const std::vector<int> half_widths = CircleHalfWidths(kOrientationPatchRadius);
-  std::vector<cv::Mat> level_descriptors;
-  for (int level = 0; level < pyramid_.num_levels; ++level) {
-    const cv::Mat& level_image = levels[level];
-    if (level_image.empty()) break;
-    std::vector<cv::KeyPoint> corners = DetectCorners(level_image, options_);
-    corners = SpreadWithQuadtree(corners, cv::Rect(0, 0, level_image.cols, level_image.rows),
-                                 features_per_level_[level]);
-    if (corners.empty()) continue;
-    cv::Mat blurred;
-    cv::GaussianBlur(level_image, blurred, cv::Size(7, 7), 2.0, 2.0, cv::BORDER_REFLECT_101);
-    cv::Mat descriptors(static_cast<int>(corners.size()), kOrbDescriptorBytes, CV_8U);
-    const double sx = static_cast<double>(image.cols) / level_image.cols;
-    const double sy = static_cast<double>(image.rows) / level_image.rows;
-    for (std::size_t i = 0; i < corners.size(); ++i) {
-      cv::KeyPoint& kp = corners[i];
-      kp.angle =
-          IntensityCentroidAngle(level_image, cvRound(kp.pt.x), cvRound(kp.pt.y), half_widths);
-      Describe(blurred, kp, pattern_, descriptors.ptr<std::uint8_t>(static_cast<int>(i)));
-      // Pixel centres map as (x + 0.5) * scale - 0.5 between levels.
-      kp.pt.x = static_cast<float>((kp.pt.x + 0.5) * sx - 0.5);
-      kp.pt.y = static_cast<float>((kp.pt.y + 0.5) * sy - 0.5);
-      kp.octave = level;
-      kp.size = static_cast<float>(2 * kOrientationPatchRadius + 1) *
-                static_cast<float>(pyramid_.scales[level]);
-      kp.class_id = -1;
-    }
-    features.keypoints.insert(features.keypoints.end(), corners.begin(), corners.end());
-    level_descriptors.push_back(descriptors);
-  }
-  if (!level_descriptors.empty()) {
-    cv::vconcat(level_descriptors, features.descriptors);
+  LazyPyramid levels(image, pyramid_);
+  std::vector<LevelFeatures> per_level(pyramid_.num_levels);
+  const auto extract_level = [&](int level) {
+    const cv::Mat& level_image = levels.Level(level);
+    if (!level_image.empty()) per_level[level] = ExtractLevel(level_image, level, image.size());
+  };
+  // Levels are handed out largest first; each thread builds the pyramid down to its level.
+  if (pool_) {
+    pool_->ParallelFor(pyramid_.num_levels, extract_level);
   } else {
-    features.descriptors.create(0, kOrbDescriptorBytes, CV_8U);
+    for (int level = 0; level < pyramid_.num_levels; ++level) extract_level(level);
+  }
+  std::size_t total = 0;
+  for (const LevelFeatures& level : per_level) total += level.keypoints.size();
+  features.keypoints.reserve(total);
+  features.descriptors.create(static_cast<int>(total), kOrbDescriptorBytes, CV_8U);
+  int row = 0;
+  for (const LevelFeatures& level : per_level) {
+    if (level.keypoints.empty()) continue;
+    features.keypoints.insert(features.keypoints.end(), level.keypoints.begin(),
+                              level.keypoints.end());
+    level.descriptors.copyTo(features.descriptors.rowRange(row, row + level.descriptors.rows));
+    row += level.descriptors.rows;
   }
   return features;
 }
