@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <mutex>
@@ -107,51 +108,131 @@ std::vector<cv::KeyPoint> DetectCorners(const cv::Mat& image, const OrbExtractor
   return corners;
 }
 
-// Half-width of the circular orientation patch for each row offset 0..radius.
-std::vector<int> CircleHalfWidths(int radius) {
-  std::vector<int> half_widths(radius + 1);
-  for (int v = 0; v <= radius; ++v) {
-    half_widths[v] = static_cast<int>(std::floor(std::sqrt(radius * radius - v * v + 1e-9)));
-  }
-  return half_widths;
-}
+// The circular orientation patch of radius kOrientationPatchRadius: its half-width on each
+// row offset, and the same as byte masks over the 32 columns u = -15..16 for the vector path.
+struct CirclePatch {
+  static constexpr int kRadius = kOrientationPatchRadius;
+  static constexpr int kColumns = 32;
+  static_assert(kColumns == 2 * kRadius + 2, "the vector path covers u = -15..16");
 
-// Orientation (degrees, [0, 360)) from the intensity centroid of the circular patch.
-float IntensityCentroidAngle(const cv::Mat& image, int x, int y,
-                             const std::vector<int>& half_widths) {
-  const int radius = static_cast<int>(half_widths.size()) - 1;
-  double m10 = 0.0, m01 = 0.0;
-  for (int v = -radius; v <= radius; ++v) {
-    const std::uint8_t* row = image.ptr<std::uint8_t>(y + v);
-    const int width = half_widths[std::abs(v)];
-    int row_sum = 0, row_moment = 0;
-    for (int u = -width; u <= width; ++u) {
-      const int value = row[x + u];
-      row_sum += value;
-      row_moment += u * value;
+  CirclePatch() {
+    for (int v = 0; v <= kRadius; ++v) {
+      half_widths[v] = static_cast<int>(std::floor(std::sqrt(kRadius * kRadius - v * v + 1e-9)));
+      for (int c = 0; c < kColumns; ++c) {
+        masks[v][c] = std::abs(c - kRadius) <= half_widths[v] ? 0xFF : 0;
+      }
     }
-    m10 += row_moment;
-    m01 += static_cast<double>(v) * row_sum;
   }
+  int half_widths[kRadius + 1];
+  alignas(16) std::uint8_t masks[kRadius + 1][kColumns];
+};
+
+// Orientation (degrees, [0, 360)) from the intensity centroid of the circular patch around
+// (x, y); rows +v and -v are taken together. The moments are exact integers.
+float IntensityCentroidAngle(const cv::Mat& image, int x, int y, const CirclePatch& patch) {
+  constexpr int kRadius = CirclePatch::kRadius;
+  const std::uint8_t* centre = image.ptr<std::uint8_t>(y) + x;
+  const int step = static_cast<int>(image.step1());
+  int m10 = 0, m01 = 0;
+#if CV_SIMD128
+  // Columns u = -15..0 in the low halves, 1..16 in the high ones; u = 16 is always masked.
+  alignas(16) static constexpr std::int16_t kU[4][8] = {{-15, -14, -13, -12, -11, -10, -9, -8},
+                                                        {-7, -6, -5, -4, -3, -2, -1, 0},
+                                                        {1, 2, 3, 4, 5, 6, 7, 8},
+                                                        {9, 10, 11, 12, 13, 14, 15, 16}};
+  cv::v_int16x8 u[4];
+  for (int k = 0; k < 4; ++k) u[k] = cv::v_load(kU[k]);
+  cv::v_int32x4 moment_x = cv::v_setzero_s32(), moment_y = cv::v_setzero_s32();
+  for (int v = 0; v <= kRadius; ++v) {
+    const std::uint8_t* up = centre - v * step - kRadius;
+    const std::uint8_t* down = centre + v * step - kRadius;
+    const cv::v_int16x8 weight_v = cv::v_setall_s16(static_cast<std::int16_t>(v));
+    for (int half = 0; half < 2; ++half) {
+      const cv::v_uint8x16 mask = cv::v_load(patch.masks[v] + 16 * half);
+      const cv::v_uint8x16 a = cv::v_load(up + 16 * half) & mask;
+      // Row 0 is counted once: as its own "down" row, with no "up" row.
+      const cv::v_uint8x16 b = v == 0 ? cv::v_setzero_u8() : cv::v_load(down + 16 * half) & mask;
+      cv::v_uint16x8 a_lo, a_hi, b_lo, b_hi;
+      cv::v_expand(a, a_lo, a_hi);
+      cv::v_expand(b, b_lo, b_hi);
+      const cv::v_int16x8 sum_lo = cv::v_reinterpret_as_s16(a_lo + b_lo);
+      const cv::v_int16x8 sum_hi = cv::v_reinterpret_as_s16(a_hi + b_hi);
+      moment_x += cv::v_dotprod(sum_lo, u[2 * half]) + cv::v_dotprod(sum_hi, u[2 * half + 1]);
+      if (v == 0) continue;
+      const cv::v_int16x8 diff_lo = cv::v_reinterpret_as_s16(b_lo) - cv::v_reinterpret_as_s16(a_lo);
+      const cv::v_int16x8 diff_hi = cv::v_reinterpret_as_s16(b_hi) - cv::v_reinterpret_as_s16(a_hi);
+      moment_y += cv::v_dotprod(diff_lo + diff_hi, weight_v);
+    }
+  }
+  m10 = cv::v_reduce_sum(moment_x);
+  m01 = cv::v_reduce_sum(moment_y);
+#else
+  for (int u = -kRadius; u <= kRadius; ++u) m10 += u * centre[u];
+  for (int v = 1; v <= kRadius; ++v) {
+    const std::uint8_t* up = centre - v * step;
+    const std::uint8_t* down = centre + v * step;
+    const int width = patch.half_widths[v];
+    int difference = 0;
+    for (int u = -width; u <= width; ++u) {
+      difference += down[u] - up[u];
+      m10 += u * (down[u] + up[u]);
+    }
+    m01 += v * difference;
+  }
+#endif
   return cv::fastAtan2(static_cast<float>(m01), static_cast<float>(m10));
 }
 
-void Describe(const cv::Mat& blurred, const cv::KeyPoint& kp, const BriefPattern& pattern,
+// The pattern's coordinates as four arrays, so that four points are rotated at a time.
+struct PatternColumns {
+  explicit PatternColumns(const BriefPattern& pattern) {
+    for (std::size_t i = 0; i < pattern.pairs.size(); ++i) {
+      ax[i] = pattern.pairs[i].ax;
+      ay[i] = pattern.pairs[i].ay;
+      bx[i] = pattern.pairs[i].bx;
+      by[i] = pattern.pairs[i].by;
+    }
+  }
+  static constexpr int kSize = 8 * kOrbDescriptorBytes;
+  alignas(16) float ax[kSize], ay[kSize], bx[kSize], by[kSize];
+};
+
+// Offsets from the keypoint's pixel, in `step`-wide rows, of the pattern points (x, y)
+// rotated by (cos, sin) = (c, s) and rounded as cvRound does (to nearest, ties to even).
+void RotatedOffsets(const float* xs, const float* ys, float c, float s, int step, int* offsets) {
+  int i = 0;
+#if CV_SIMD128
+  const cv::v_float32x4 vc = cv::v_setall_f32(c), vs = cv::v_setall_f32(s);
+  const cv::v_int32x4 vstep = cv::v_setall_s32(step);
+  for (; i + 4 <= PatternColumns::kSize; i += 4) {
+    const cv::v_float32x4 x = cv::v_load(xs + i), y = cv::v_load(ys + i);
+    const cv::v_int32x4 row = cv::v_round(x * vs + y * vc);
+    const cv::v_int32x4 col = cv::v_round(x * vc - y * vs);
+    cv::v_store(offsets + i, row * vstep + col);
+  }
+#endif
+  for (; i < PatternColumns::kSize; ++i) {
+    offsets[i] = cvRound(xs[i] * s + ys[i] * c) * step + cvRound(xs[i] * c - ys[i] * s);
+  }
+}
+
+// Rotated BRIEF: bit 8 * byte + bit of the descriptor is set when the blurred intensity at
+// the pair's first rotated point is below that at its second.
+void Describe(const cv::Mat& blurred, const cv::KeyPoint& kp, const PatternColumns& pattern,
               std::uint8_t* descriptor) {
   const float angle = kp.angle * static_cast<float>(CV_PI / 180.0);
   const float c = std::cos(angle), s = std::sin(angle);
   const std::uint8_t* centre = blurred.ptr<std::uint8_t>(cvRound(kp.pt.y)) + cvRound(kp.pt.x);
   const int step = static_cast<int>(blurred.step1());
-  auto sample = [&](float px, float py) {
-    return centre[cvRound(px * s + py * c) * step + cvRound(px * c - py * s)];
-  };
+  alignas(16) int offsets_a[PatternColumns::kSize], offsets_b[PatternColumns::kSize];
+  RotatedOffsets(pattern.ax, pattern.ay, c, s, step, offsets_a);
+  RotatedOffsets(pattern.bx, pattern.by, c, s, step, offsets_b);
   for (int byte = 0; byte < kOrbDescriptorBytes; ++byte) {
-    std::uint8_t value = 0;
-    for (int bit = 0; bit < 8; ++bit) {
-      const BriefPair& pair = pattern.pairs[8 * byte + bit];
-      if (sample(pair.ax, pair.ay) < sample(pair.bx, pair.by)) value |= (1u << bit);
-    }
-    descriptor[byte] = value;
+    const int* a = offsets_a + 8 * byte;
+    const int* b = offsets_b + 8 * byte;
+    unsigned value = 0;
+    for (int bit = 0; bit < 8; ++bit) value |= unsigned{centre[a[bit]] < centre[b[bit]]} << bit;
+    descriptor[byte] = static_cast<std::uint8_t>(value);
   }
 }
 
@@ -187,14 +268,15 @@ OrbExtractor::LevelFeatures OrbExtractor::ExtractLevel(const cv::Mat& level_imag
   cv::Mat blurred;
   cv::GaussianBlur(level_image, blurred, cv::Size(7, 7), 2.0, 2.0, cv::BORDER_REFLECT_101);
   result.descriptors.create(static_cast<int>(corners.size()), kOrbDescriptorBytes, CV_8U);
-  const std::vector<int> half_widths = CircleHalfWidths(kOrientationPatchRadius);
+  const CirclePatch circle;
+  const PatternColumns pattern(pattern_);
   const double sx = static_cast<double>(image_size.width) / level_image.cols;
   const double sy = static_cast<double>(image_size.height) / level_image.rows;
   for (std::size_t i = 0; i < corners.size(); ++i) {
     cv::KeyPoint& kp = corners[i];
     kp.angle =
-        IntensityCentroidAngle(level_image, cvRound(kp.pt.x), cvRound(kp.pt.y), half_widths);
-    Describe(blurred, kp, pattern_, result.descriptors.ptr<std::uint8_t>(static_cast<int>(i)));
+        IntensityCentroidAngle(level_image, cvRound(kp.pt.x), cvRound(kp.pt.y), circle);
+    Describe(blurred, kp, pattern, result.descriptors.ptr<std::uint8_t>(static_cast<int>(i)));
     // Pixel centres map as (x + 0.5) * scale - 0.5 between levels.
     kp.pt.x = static_cast<float>((kp.pt.x + 0.5) * sx - 0.5);
     kp.pt.y = static_cast<float>((kp.pt.y + 0.5) * sy - 0.5);
