@@ -21,8 +21,9 @@ struct OrbExtractorOptions {
   int cell_size_px = 32;            // side of the grid cells for the threshold fallback (pixels)
   int edge_margin_px = 16;          // border of each level with no keypoints (>= patch radius + 1)
   // Threads that build, detect and describe the pyramid levels (the calling thread counts as
-  // one; 1 = no thread of the extractor's own). The output is the same for any count.
-  int num_threads = 2;
+  // one; 1 = no thread of the extractor's own). The output is the same for any count. 2 is
+  // faster alone on two cores but slower in a `run` sharing them (BENCHMARKS.md).
+  int num_threads = 1;
 
   bool Check() const;
 };
