@@ -1,6 +1,7 @@
 // ORB extraction, matching and initialisation timings: our extractor vs cv::ORB (1000
-// features, 8 levels, factor 1.2) on real EuRoC frames at 752x480 and a 640x480 crop, with
-// the spread of the keypoints (fraction of the cells of an 8x6 grid that hold one).
+// features, 8 levels, factor 1.2) on real EuRoC frames at 752x480 and a 640x480 crop and a
+// KITTI frame at 1226x370, with the spread of the keypoints (fraction of the cells of an 8x6
+// grid that hold one).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -38,6 +39,15 @@ cv::Mat LoadFrame(int index, int width) {
   return image(cv::Rect((image.cols - width) / 2, 0, width, image.rows)).clone();
 }
 
+const std::string kKittiFrame =
+    std::string(ARUCOSLAM_TEST_DATA_DIR) + "/kitti07_first160/original/image_0/000000.png";
+
+// The EuRoC frame at width 640 or 752, the KITTI frame at 1226 (empty when missing).
+cv::Mat LoadBenchFrame(int width) {
+  if (width == 1226) return cv::imread(kKittiFrame, cv::IMREAD_GRAYSCALE);
+  return LoadFrame(10, width);
+}
+
 double OccupiedFraction(const std::vector<cv::KeyPoint>& keypoints, cv::Size size) {
   std::vector<bool> occupied(48, false);
   for (const cv::KeyPoint& kp : keypoints) {
@@ -48,13 +58,16 @@ double OccupiedFraction(const std::vector<cv::KeyPoint>& keypoints, cv::Size siz
   return std::count(occupied.begin(), occupied.end(), true) / 48.0;
 }
 
+// Args: image width (640, 752: EuRoC; 1226: KITTI), OrbExtractorOptions::num_threads.
 void BM_OwnOrbExtract(benchmark::State& state) {
-  const cv::Mat image = LoadFrame(10, static_cast<int>(state.range(0)));
+  const cv::Mat image = LoadBenchFrame(static_cast<int>(state.range(0)));
   if (image.empty()) {
-    state.SkipWithError("euroc_v101_micro missing");
+    state.SkipWithError("euroc_v101_micro or kitti07_first160 missing");
     return;
   }
-  const OrbExtractor extractor;
+  OrbExtractorOptions options;
+  options.num_threads = static_cast<int>(state.range(1));
+  const OrbExtractor extractor(options);
   OrbFeatures features;
   for (auto _ : state) {
     features = extractor.Extract(image);
@@ -63,10 +76,14 @@ void BM_OwnOrbExtract(benchmark::State& state) {
   state.counters["keypoints"] = static_cast<double>(features.size());
   state.counters["occupied_8x6"] = OccupiedFraction(features.keypoints, image.size());
 }
-BENCHMARK(BM_OwnOrbExtract)->Arg(640)->Arg(752)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_OwnOrbExtract)
+    ->ArgsProduct({{640, 752, 1226}, {1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
 
 void BM_OpenCvOrbExtract(benchmark::State& state) {
-  const cv::Mat image = LoadFrame(10, static_cast<int>(state.range(0)));
+  const cv::Mat image = LoadBenchFrame(static_cast<int>(state.range(0)));
   if (image.empty()) {
     state.SkipWithError("euroc_v101_micro missing");
     return;
@@ -81,7 +98,7 @@ void BM_OpenCvOrbExtract(benchmark::State& state) {
   state.counters["keypoints"] = static_cast<double>(keypoints.size());
   state.counters["occupied_8x6"] = OccupiedFraction(keypoints, image.size());
 }
-BENCHMARK(BM_OpenCvOrbExtract)->Arg(640)->Arg(752)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_OpenCvOrbExtract)->Arg(640)->Arg(752)->Arg(1226)->Unit(benchmark::kMillisecond);
 
 void BM_MatchBruteForce(benchmark::State& state) {
   const cv::Mat image1 = LoadFrame(10, 752), image2 = LoadFrame(30, 752);

@@ -2,9 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
-#include <queue>
+#include <mutex>
 #include <stdexcept>
 
 #include "arucoslam/feature/quadtree_spread.h"
@@ -29,17 +30,37 @@ std::vector<int> FeaturesPerLevel(const OrbExtractorOptions& options) {
   return counts;
 }
 
-std::vector<cv::Mat> BuildPyramid(const cv::Mat& image, const ScalePyramid& pyramid) {
-  std::vector<cv::Mat> levels(pyramid.num_levels);
-  levels[0] = image;
-  for (int level = 1; level < pyramid.num_levels; ++level) {
-    const cv::Size size(static_cast<int>(std::lround(image.cols * pyramid.inverse_scales[level])),
-                        static_cast<int>(std::lround(image.rows * pyramid.inverse_scales[level])));
-    if (size.width < 1 || size.height < 1) break;
-    cv::resize(levels[level - 1], levels[level], size, 0.0, 0.0, cv::INTER_LINEAR);
+// The pyramid's images, each built from the one above it when first asked for, so that the
+// threads can start on the large levels before the small ones exist.
+class LazyPyramid {
+ public:
+  LazyPyramid(const cv::Mat& image, const ScalePyramid& pyramid)
+      : pyramid_(pyramid), levels_(pyramid.num_levels) {
+    levels_[0] = image;
   }
-  return levels;
-}
+
+  // Level `level`'s image; empty when the level would be smaller than one pixel.
+  const cv::Mat& Level(int level) {
+    if (level == 0) return levels_[0];
+    std::lock_guard<std::mutex> lock(mutex_);
+    const cv::Mat& image = levels_[0];
+    for (; built_ < level; ++built_) {
+      const int next = built_ + 1;
+      const cv::Size size(
+          static_cast<int>(std::lround(image.cols * pyramid_.inverse_scales[next])),
+          static_cast<int>(std::lround(image.rows * pyramid_.inverse_scales[next])));
+      if (size.width < 1 || size.height < 1 || levels_[built_].empty()) continue;
+      cv::resize(levels_[built_], levels_[next], size, 0.0, 0.0, cv::INTER_LINEAR);
+    }
+    return levels_[level];
+  }
+
+ private:
+  const ScalePyramid& pyramid_;
+  std::vector<cv::Mat> levels_;
+  std::mutex mutex_;
+  int built_ = 0;  // levels [0, built_] exist (or are known to be empty)
+};
 
 // FAST corners inside [margin, cols - margin) x [margin, rows - margin) of one level: the
 // initial threshold over the whole region, the low one in grid cells left empty.
@@ -87,51 +108,131 @@ std::vector<cv::KeyPoint> DetectCorners(const cv::Mat& image, const OrbExtractor
   return corners;
 }
 
-// Half-width of the circular orientation patch for each row offset 0..radius.
-std::vector<int> CircleHalfWidths(int radius) {
-  std::vector<int> half_widths(radius + 1);
-  for (int v = 0; v <= radius; ++v) {
-    half_widths[v] = static_cast<int>(std::floor(std::sqrt(radius * radius - v * v + 1e-9)));
-  }
-  return half_widths;
-}
+// The circular orientation patch of radius kOrientationPatchRadius: its half-width on each
+// row offset, and the same as byte masks over the 32 columns u = -15..16 for the vector path.
+struct CirclePatch {
+  static constexpr int kRadius = kOrientationPatchRadius;
+  static constexpr int kColumns = 32;
+  static_assert(kColumns == 2 * kRadius + 2, "the vector path covers u = -15..16");
 
-// Orientation (degrees, [0, 360)) from the intensity centroid of the circular patch.
-float IntensityCentroidAngle(const cv::Mat& image, int x, int y,
-                             const std::vector<int>& half_widths) {
-  const int radius = static_cast<int>(half_widths.size()) - 1;
-  double m10 = 0.0, m01 = 0.0;
-  for (int v = -radius; v <= radius; ++v) {
-    const std::uint8_t* row = image.ptr<std::uint8_t>(y + v);
-    const int width = half_widths[std::abs(v)];
-    int row_sum = 0, row_moment = 0;
-    for (int u = -width; u <= width; ++u) {
-      const int value = row[x + u];
-      row_sum += value;
-      row_moment += u * value;
+  CirclePatch() {
+    for (int v = 0; v <= kRadius; ++v) {
+      half_widths[v] = static_cast<int>(std::floor(std::sqrt(kRadius * kRadius - v * v + 1e-9)));
+      for (int c = 0; c < kColumns; ++c) {
+        masks[v][c] = std::abs(c - kRadius) <= half_widths[v] ? 0xFF : 0;
+      }
     }
-    m10 += row_moment;
-    m01 += static_cast<double>(v) * row_sum;
   }
+  int half_widths[kRadius + 1];
+  alignas(16) std::uint8_t masks[kRadius + 1][kColumns];
+};
+
+// Orientation (degrees, [0, 360)) from the intensity centroid of the circular patch around
+// (x, y); rows +v and -v are taken together. The moments are exact integers.
+float IntensityCentroidAngle(const cv::Mat& image, int x, int y, const CirclePatch& patch) {
+  constexpr int kRadius = CirclePatch::kRadius;
+  const std::uint8_t* centre = image.ptr<std::uint8_t>(y) + x;
+  const int step = static_cast<int>(image.step1());
+  int m10 = 0, m01 = 0;
+#if CV_SIMD128
+  // Columns u = -15..0 in the low halves, 1..16 in the high ones; u = 16 is always masked.
+  alignas(16) static constexpr std::int16_t kU[4][8] = {{-15, -14, -13, -12, -11, -10, -9, -8},
+                                                        {-7, -6, -5, -4, -3, -2, -1, 0},
+                                                        {1, 2, 3, 4, 5, 6, 7, 8},
+                                                        {9, 10, 11, 12, 13, 14, 15, 16}};
+  cv::v_int16x8 u[4];
+  for (int k = 0; k < 4; ++k) u[k] = cv::v_load(kU[k]);
+  cv::v_int32x4 moment_x = cv::v_setzero_s32(), moment_y = cv::v_setzero_s32();
+  for (int v = 0; v <= kRadius; ++v) {
+    const std::uint8_t* up = centre - v * step - kRadius;
+    const std::uint8_t* down = centre + v * step - kRadius;
+    const cv::v_int16x8 weight_v = cv::v_setall_s16(static_cast<std::int16_t>(v));
+    for (int half = 0; half < 2; ++half) {
+      const cv::v_uint8x16 mask = cv::v_load(patch.masks[v] + 16 * half);
+      const cv::v_uint8x16 a = cv::v_load(up + 16 * half) & mask;
+      // Row 0 is counted once: as its own "down" row, with no "up" row.
+      const cv::v_uint8x16 b = v == 0 ? cv::v_setzero_u8() : cv::v_load(down + 16 * half) & mask;
+      cv::v_uint16x8 a_lo, a_hi, b_lo, b_hi;
+      cv::v_expand(a, a_lo, a_hi);
+      cv::v_expand(b, b_lo, b_hi);
+      const cv::v_int16x8 sum_lo = cv::v_reinterpret_as_s16(a_lo + b_lo);
+      const cv::v_int16x8 sum_hi = cv::v_reinterpret_as_s16(a_hi + b_hi);
+      moment_x += cv::v_dotprod(sum_lo, u[2 * half]) + cv::v_dotprod(sum_hi, u[2 * half + 1]);
+      if (v == 0) continue;
+      const cv::v_int16x8 diff_lo = cv::v_reinterpret_as_s16(b_lo) - cv::v_reinterpret_as_s16(a_lo);
+      const cv::v_int16x8 diff_hi = cv::v_reinterpret_as_s16(b_hi) - cv::v_reinterpret_as_s16(a_hi);
+      moment_y += cv::v_dotprod(diff_lo + diff_hi, weight_v);
+    }
+  }
+  m10 = cv::v_reduce_sum(moment_x);
+  m01 = cv::v_reduce_sum(moment_y);
+#else
+  for (int u = -kRadius; u <= kRadius; ++u) m10 += u * centre[u];
+  for (int v = 1; v <= kRadius; ++v) {
+    const std::uint8_t* up = centre - v * step;
+    const std::uint8_t* down = centre + v * step;
+    const int width = patch.half_widths[v];
+    int difference = 0;
+    for (int u = -width; u <= width; ++u) {
+      difference += down[u] - up[u];
+      m10 += u * (down[u] + up[u]);
+    }
+    m01 += v * difference;
+  }
+#endif
   return cv::fastAtan2(static_cast<float>(m01), static_cast<float>(m10));
 }
 
-void Describe(const cv::Mat& blurred, const cv::KeyPoint& kp, const BriefPattern& pattern,
+// The pattern's coordinates as four arrays, so that four points are rotated at a time.
+struct PatternColumns {
+  explicit PatternColumns(const BriefPattern& pattern) {
+    for (std::size_t i = 0; i < pattern.pairs.size(); ++i) {
+      ax[i] = pattern.pairs[i].ax;
+      ay[i] = pattern.pairs[i].ay;
+      bx[i] = pattern.pairs[i].bx;
+      by[i] = pattern.pairs[i].by;
+    }
+  }
+  static constexpr int kSize = 8 * kOrbDescriptorBytes;
+  alignas(16) float ax[kSize], ay[kSize], bx[kSize], by[kSize];
+};
+
+// Offsets from the keypoint's pixel, in `step`-wide rows, of the pattern points (x, y)
+// rotated by (cos, sin) = (c, s) and rounded as cvRound does (to nearest, ties to even).
+void RotatedOffsets(const float* xs, const float* ys, float c, float s, int step, int* offsets) {
+  int i = 0;
+#if CV_SIMD128
+  const cv::v_float32x4 vc = cv::v_setall_f32(c), vs = cv::v_setall_f32(s);
+  const cv::v_int32x4 vstep = cv::v_setall_s32(step);
+  for (; i + 4 <= PatternColumns::kSize; i += 4) {
+    const cv::v_float32x4 x = cv::v_load(xs + i), y = cv::v_load(ys + i);
+    const cv::v_int32x4 row = cv::v_round(x * vs + y * vc);
+    const cv::v_int32x4 col = cv::v_round(x * vc - y * vs);
+    cv::v_store(offsets + i, row * vstep + col);
+  }
+#endif
+  for (; i < PatternColumns::kSize; ++i) {
+    offsets[i] = cvRound(xs[i] * s + ys[i] * c) * step + cvRound(xs[i] * c - ys[i] * s);
+  }
+}
+
+// Rotated BRIEF: bit 8 * byte + bit of the descriptor is set when the blurred intensity at
+// the pair's first rotated point is below that at its second.
+void Describe(const cv::Mat& blurred, const cv::KeyPoint& kp, const PatternColumns& pattern,
               std::uint8_t* descriptor) {
   const float angle = kp.angle * static_cast<float>(CV_PI / 180.0);
   const float c = std::cos(angle), s = std::sin(angle);
   const std::uint8_t* centre = blurred.ptr<std::uint8_t>(cvRound(kp.pt.y)) + cvRound(kp.pt.x);
   const int step = static_cast<int>(blurred.step1());
-  auto sample = [&](float px, float py) {
-    return centre[cvRound(px * s + py * c) * step + cvRound(px * c - py * s)];
-  };
+  alignas(16) int offsets_a[PatternColumns::kSize], offsets_b[PatternColumns::kSize];
+  RotatedOffsets(pattern.ax, pattern.ay, c, s, step, offsets_a);
+  RotatedOffsets(pattern.bx, pattern.by, c, s, step, offsets_b);
   for (int byte = 0; byte < kOrbDescriptorBytes; ++byte) {
-    std::uint8_t value = 0;
-    for (int bit = 0; bit < 8; ++bit) {
-      const BriefPair& pair = pattern.pairs[8 * byte + bit];
-      if (sample(pair.ax, pair.ay) < sample(pair.bx, pair.by)) value |= (1u << bit);
-    }
-    descriptor[byte] = value;
+    const int* a = offsets_a + 8 * byte;
+    const int* b = offsets_b + 8 * byte;
+    unsigned value = 0;
+    for (int bit = 0; bit < 8; ++bit) value |= unsigned{centre[a[bit]] < centre[b[bit]]} << bit;
+    descriptor[byte] = static_cast<std::uint8_t>(value);
   }
 }
 
@@ -141,7 +242,7 @@ bool OrbExtractorOptions::Check() const {
   return num_features > 0 && num_levels >= 1 && num_levels <= 32 && scale_factor > 1.0 &&
          initial_fast_threshold > 0 && min_fast_threshold > 0 &&
          min_fast_threshold <= initial_fast_threshold && cell_size_px >= 8 &&
-         edge_margin_px >= kOrientationPatchRadius + 1;
+         edge_margin_px >= kOrientationPatchRadius + 1 && num_threads >= 1 && num_threads <= 64;
 }
 
 OrbExtractor::OrbExtractor(const OrbExtractorOptions& options)
@@ -150,6 +251,42 @@ OrbExtractor::OrbExtractor(const OrbExtractorOptions& options)
       features_per_level_(FeaturesPerLevel(options)),
       pattern_(BriefPattern::Generate()) {
   if (!options_.Check()) throw std::invalid_argument("OrbExtractorOptions: invalid values");
+  if (options_.num_threads > 1) pool_ = std::make_unique<ThreadPool>(options_.num_threads);
+}
+
+OrbExtractor::~OrbExtractor() = default;
+OrbExtractor::OrbExtractor(OrbExtractor&&) noexcept = default;
+OrbExtractor& OrbExtractor::operator=(OrbExtractor&&) noexcept = default;
+
+OrbExtractor::LevelFeatures OrbExtractor::ExtractLevel(const cv::Mat& level_image, int level,
+                                                       cv::Size image_size) const {
+  LevelFeatures result;
+  std::vector<cv::KeyPoint> corners = DetectCorners(level_image, options_);
+  corners = SpreadWithQuadtree(corners, cv::Rect(0, 0, level_image.cols, level_image.rows),
+                               features_per_level_[level]);
+  if (corners.empty()) return result;
+  cv::Mat blurred;
+  cv::GaussianBlur(level_image, blurred, cv::Size(7, 7), 2.0, 2.0, cv::BORDER_REFLECT_101);
+  result.descriptors.create(static_cast<int>(corners.size()), kOrbDescriptorBytes, CV_8U);
+  const CirclePatch circle;
+  const PatternColumns pattern(pattern_);
+  const double sx = static_cast<double>(image_size.width) / level_image.cols;
+  const double sy = static_cast<double>(image_size.height) / level_image.rows;
+  for (std::size_t i = 0; i < corners.size(); ++i) {
+    cv::KeyPoint& kp = corners[i];
+    kp.angle =
+        IntensityCentroidAngle(level_image, cvRound(kp.pt.x), cvRound(kp.pt.y), circle);
+    Describe(blurred, kp, pattern, result.descriptors.ptr<std::uint8_t>(static_cast<int>(i)));
+    // Pixel centres map as (x + 0.5) * scale - 0.5 between levels.
+    kp.pt.x = static_cast<float>((kp.pt.x + 0.5) * sx - 0.5);
+    kp.pt.y = static_cast<float>((kp.pt.y + 0.5) * sy - 0.5);
+    kp.octave = level;
+    kp.size = static_cast<float>(2 * kOrientationPatchRadius + 1) *
+              static_cast<float>(pyramid_.scales[level]);
+    kp.class_id = -1;
+  }
+  result.keypoints = std::move(corners);
+  return result;
 }
 
 OrbFeatures OrbExtractor::Extract(const cv::Mat& image) const {
@@ -160,41 +297,29 @@ OrbFeatures OrbExtractor::Extract(const cv::Mat& image) const {
   features.pyramid = pyramid_;
   features.image_width = image.cols;
   features.image_height = image.rows;
-  const std::vector<cv::Mat> levels = BuildPyramid(image, pyramid_);
-  const std::vector<int> half_widths = CircleHalfWidths(kOrientationPatchRadius);
-  std::vector<cv::Mat> level_descriptors;
-  for (int level = 0; level < pyramid_.num_levels; ++level) {
-    const cv::Mat& level_image = levels[level];
-    if (level_image.empty()) break;
-    std::vector<cv::KeyPoint> corners = DetectCorners(level_image, options_);
-    corners = SpreadWithQuadtree(corners, cv::Rect(0, 0, level_image.cols, level_image.rows),
-                                 features_per_level_[level]);
-    if (corners.empty()) continue;
-    cv::Mat blurred;
-    cv::GaussianBlur(level_image, blurred, cv::Size(7, 7), 2.0, 2.0, cv::BORDER_REFLECT_101);
-    cv::Mat descriptors(static_cast<int>(corners.size()), kOrbDescriptorBytes, CV_8U);
-    const double sx = static_cast<double>(image.cols) / level_image.cols;
-    const double sy = static_cast<double>(image.rows) / level_image.rows;
-    for (std::size_t i = 0; i < corners.size(); ++i) {
-      cv::KeyPoint& kp = corners[i];
-      kp.angle =
-          IntensityCentroidAngle(level_image, cvRound(kp.pt.x), cvRound(kp.pt.y), half_widths);
-      Describe(blurred, kp, pattern_, descriptors.ptr<std::uint8_t>(static_cast<int>(i)));
-      // Pixel centres map as (x + 0.5) * scale - 0.5 between levels.
-      kp.pt.x = static_cast<float>((kp.pt.x + 0.5) * sx - 0.5);
-      kp.pt.y = static_cast<float>((kp.pt.y + 0.5) * sy - 0.5);
-      kp.octave = level;
-      kp.size = static_cast<float>(2 * kOrientationPatchRadius + 1) *
-                static_cast<float>(pyramid_.scales[level]);
-      kp.class_id = -1;
-    }
-    features.keypoints.insert(features.keypoints.end(), corners.begin(), corners.end());
-    level_descriptors.push_back(descriptors);
-  }
-  if (!level_descriptors.empty()) {
-    cv::vconcat(level_descriptors, features.descriptors);
+  LazyPyramid levels(image, pyramid_);
+  std::vector<LevelFeatures> per_level(pyramid_.num_levels);
+  const auto extract_level = [&](int level) {
+    const cv::Mat& level_image = levels.Level(level);
+    if (!level_image.empty()) per_level[level] = ExtractLevel(level_image, level, image.size());
+  };
+  // Levels are handed out largest first; each thread builds the pyramid down to its level.
+  if (pool_) {
+    pool_->ParallelFor(pyramid_.num_levels, extract_level);
   } else {
-    features.descriptors.create(0, kOrbDescriptorBytes, CV_8U);
+    for (int level = 0; level < pyramid_.num_levels; ++level) extract_level(level);
+  }
+  std::size_t total = 0;
+  for (const LevelFeatures& level : per_level) total += level.keypoints.size();
+  features.keypoints.reserve(total);
+  features.descriptors.create(static_cast<int>(total), kOrbDescriptorBytes, CV_8U);
+  int row = 0;
+  for (const LevelFeatures& level : per_level) {
+    if (level.keypoints.empty()) continue;
+    features.keypoints.insert(features.keypoints.end(), level.keypoints.begin(),
+                              level.keypoints.end());
+    level.descriptors.copyTo(features.descriptors.rowRange(row, row + level.descriptors.rows));
+    row += level.descriptors.rows;
   }
   return features;
 }

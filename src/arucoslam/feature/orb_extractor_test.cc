@@ -56,6 +56,9 @@ TEST(OrbExtractorOptions, CheckRejectsBadValues) {
   options.edge_margin_px = 10;  // smaller than the orientation patch
   EXPECT_FALSE(options.Check());
   options = {};
+  options.num_threads = 0;
+  EXPECT_FALSE(options.Check());
+  options = {};
   options.num_features = 0;
   EXPECT_FALSE(options.Check());
   EXPECT_THROW(OrbExtractor{options}, std::invalid_argument);
@@ -168,6 +171,68 @@ TEST(OrbExtractor, EurocFrameCountSpreadAndDeterminism) {
   const OrbFeatures again = extractor.Extract(image);
   ASSERT_EQ(again.size(), features.size());
   EXPECT_EQ(cv::norm(again.descriptors, features.descriptors, cv::NORM_L1), 0.0);
+}
+
+// Keypoints (position, level, orientation, size, score) and descriptors are bit for bit equal.
+void ExpectIdentical(const OrbFeatures& a, const OrbFeatures& b) {
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_EQ(a.descriptors.rows, b.descriptors.rows);
+  ASSERT_EQ(a.descriptors.type(), b.descriptors.type());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const cv::KeyPoint &ka = a.keypoints[i], &kb = b.keypoints[i];
+    ASSERT_EQ(ka.pt.x, kb.pt.x) << i;
+    ASSERT_EQ(ka.pt.y, kb.pt.y) << i;
+    ASSERT_EQ(ka.octave, kb.octave) << i;
+    ASSERT_EQ(ka.angle, kb.angle) << i;
+    ASSERT_EQ(ka.size, kb.size) << i;
+    ASSERT_EQ(ka.response, kb.response) << i;
+  }
+  if (a.descriptors.rows > 0) {
+    EXPECT_EQ(cv::norm(a.descriptors, b.descriptors, cv::NORM_HAMMING), 0.0);
+  }
+}
+
+// The same image through extractors with 1, 2 and 3 threads.
+void ExpectSameForAnyThreadCount(const cv::Mat& image, OrbExtractorOptions options = {}) {
+  options.num_threads = 1;
+  const OrbFeatures single = OrbExtractor(options).Extract(image);
+  for (int threads : {2, 3}) {
+    options.num_threads = threads;
+    const OrbExtractor extractor(options);
+    SCOPED_TRACE(testing::Message() << threads << " threads");
+    ExpectIdentical(extractor.Extract(image), single);
+    ExpectIdentical(extractor.Extract(image), single);  // the pool's second loop
+  }
+}
+
+// Smoothed noise of the given size, fixed seed.
+cv::Mat SyntheticImage(cv::Size size) {
+  cv::Mat noise(size, CV_8U);
+  cv::RNG rng(7);
+  rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
+  cv::Mat image;
+  cv::GaussianBlur(noise, image, cv::Size(5, 5), 1.5);
+  return image;
+}
+
+TEST(OrbExtractor, ThreadCountDoesNotChangeTheOutputOnSyntheticImages) {
+  ExpectSameForAnyThreadCount(SyntheticImage(cv::Size(640, 480)));
+  // Small: the last levels are too small for keypoints or vanish.
+  ExpectSameForAnyThreadCount(SyntheticImage(cv::Size(90, 70)));
+  OrbExtractorOptions options;
+  options.num_features = 2500;
+  options.num_levels = 12;
+  ExpectSameForAnyThreadCount(SyntheticImage(cv::Size(1226, 370)), options);
+}
+
+TEST(OrbExtractor, ThreadCountDoesNotChangeTheOutputOnRealImages) {
+  SKIP_WITHOUT_EUROC();
+  const cv::Mat euroc = LoadEurocFrame(10);
+  ExpectSameForAnyThreadCount(euroc(cv::Rect((euroc.cols - 640) / 2, 0, 640, 480)).clone());
+  const std::string kitti =
+      std::string(ARUCOSLAM_TEST_DATA_DIR) + "/kitti07_first160/original/image_0/000000.png";
+  if (!std::filesystem::exists(kitti)) GTEST_SKIP() << "test data missing: " << kitti;
+  ExpectSameForAnyThreadCount(cv::imread(kitti, cv::IMREAD_GRAYSCALE));
 }
 
 // Warps the image with a similarity about its centre and checks that keypoints come back at
