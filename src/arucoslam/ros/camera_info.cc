@@ -35,11 +35,21 @@ sensor_msgs::CameraInfo CameraInfoFromModel(const CameraModel& camera) {
       break;
     case DistortionModel::kRadTan:
       info.distortion_model = "plumb_bob";
-      info.D.assign(camera.distortion.begin(), camera.distortion.end());
+      info.D.assign(camera.distortion.begin(), camera.distortion.begin() + 5);
       break;
     case DistortionModel::kEquidistant:
       info.distortion_model = "equidistant";
       info.D.assign(camera.distortion.begin(), camera.distortion.begin() + 4);
+      break;
+    case DistortionModel::kRational:
+      info.distortion_model = "rational_polynomial";
+      info.D.assign(camera.distortion.begin(), camera.distortion.begin() + 8);
+      break;
+    case DistortionModel::kThinPrism:
+    case DistortionModel::kTilted:
+      // camera_info has no name for these: the full OpenCV vector under its own label.
+      info.distortion_model = DistortionModelName(camera.model);
+      info.D.assign(camera.distortion.begin(), camera.distortion.end());
       break;
   }
   return info;

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+
 #include "arucoslam/util/error.h"
 
 namespace arucoslam {
@@ -46,16 +49,30 @@ TEST(CameraInfoTest, EquidistantAndDistortionFree) {
   EXPECT_EQ(CameraFromInfo(info, "t").model, DistortionModel::kNone);
 }
 
+TEST(CameraInfoTest, RationalPolynomialRoundTripsExactly) {
+  CameraModel camera = RadTanCamera();
+  camera.model = DistortionModel::kRational;
+  camera.distortion = {};
+  const std::array<double, 8> rational = {0.16443, -0.98662, 0.003473, -0.002772,
+                                          1.89095, 0.04109,  0.06374,  -0.06795};
+  std::copy(rational.begin(), rational.end(), camera.distortion.begin());
+  const sensor_msgs::CameraInfo info = CameraInfoFromModel(camera);
+  EXPECT_EQ(info.distortion_model, "rational_polynomial");
+  EXPECT_EQ(info.D.size(), 8u);
+  const CameraModel back = CameraFromInfo(info, "t");
+  EXPECT_EQ(back.model, DistortionModel::kRational);
+  EXPECT_EQ(back.distortion, camera.distortion);
+}
+
 TEST(CameraInfoTest, RefusalsNameTheSourceAndField) {
   sensor_msgs::CameraInfo info = CameraInfoFromModel(RadTanCamera());
-  info.distortion_model = "rational_polynomial";
-  info.D.resize(8, 0.0);
+  info.distortion_model = "division";
   try {
     CameraFromInfo(info, "x.bag: /cam/camera_info");
     FAIL() << "no error";
   } catch (const InputError& error) {
     EXPECT_EQ(error.source(), "x.bag: /cam/camera_info");
-    EXPECT_NE(error.message().find("rational_polynomial"), std::string::npos) << error.what();
+    EXPECT_NE(error.message().find("division"), std::string::npos) << error.what();
   }
   info = CameraInfoFromModel(RadTanCamera());
   info.K = {};  // an uncalibrated camera publishes K = 0
