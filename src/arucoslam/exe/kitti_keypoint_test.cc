@@ -4,14 +4,11 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <optional>
 #include <string>
 
-#include "arucoslam/eval/alignment.h"
-#include "arucoslam/eval/association.h"
+#include "arucoslam/eval/evaluation.h"
 #include "arucoslam/exe/command_test_util.h"
 #include "arucoslam/io/trajectory_io.h"
 
@@ -38,22 +35,18 @@ TEST(KittiKeypointSlam, First160FramesOfSequence07) {
       ReadEurocTrajectory(sequence / "mav0" / "state_groundtruth_estimate0" / "data.csv");
   const Trajectory est = ReadTumTrajectory(out / "trajectory.tum");
   ASSERT_EQ(gt.size(), 160u);
-  const AssociatedTrajectories pairs = AssociateByTime(gt, est, {0.005});
-  ASSERT_EQ(pairs.size(), est.size());
-  const double posed = static_cast<double>(pairs.size()) / gt.size();
-  AlignmentOptions align;
-  align.mode = AlignmentMode::kSim3;
-  const std::optional<AlignmentResult> alignment = ComputeAlignment(pairs, align);
-  ASSERT_TRUE(alignment);
-  const Trajectory aligned = ApplyAlignment(alignment->gt_from_est, pairs.est);
-  double sum_sq = 0.0;
-  for (std::size_t i = 0; i < pairs.size(); ++i) {
-    sum_sq += (aligned.poses[i].translation - pairs.gt.poses[i].translation).squaredNorm();
-  }
-  const double ate = std::sqrt(sum_sq / pairs.size());
+  EvaluationOptions evaluation_options;
+  evaluation_options.association.max_time_difference = 0.005;
+  evaluation_options.alignment.mode = AlignmentMode::kSim3;
+  const TrajectoryEvaluation evaluation =
+      EvaluateTrajectory(gt, est, "run", (out / "trajectory.tum").string(), evaluation_options);
+  ASSERT_EQ(evaluation.pairs.size(), est.size());
+  const double posed = static_cast<double>(evaluation.pairs.size()) / gt.size();
+  const double ate = evaluation.ape_translation.rmse;
   std::printf("posed %.1f%% of 160 frames, Sim3 ATE %.4f m\n", 100.0 * posed, ate);
-  // The blocking run measured 0.46 m with 99.4% of the frames (BENCHMARKS.md, "Keypoint SLAM
-  // on KITTI 07"); before the initialiser judged the plane's twin motion it was 1.22 m.
+  // Measured: 99.4% of the frames, 0.462 m (BENCHMARKS.md, "Keypoint SLAM on KITTI 07"); 1.22 m
+  // before the initialiser told the road plane's twin motion apart. The issue's target,
+  // 0.30 m (ORB-SLAM3 v1.0: 0.31 m), is not reached yet: the map's scale grows in the turns.
   EXPECT_GE(posed, 0.97);
   EXPECT_LE(ate, 0.60);
   fs::remove_all(out);
