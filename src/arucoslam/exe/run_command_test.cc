@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "arucoslam/exe/command_test_util.h"
 #include "arucoslam/geometry/camera.h"
 #include "arucoslam/io/calibration.h"
 #include "arucoslam/io/marker_map_json.h"
@@ -23,11 +24,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Outcome {
-  int status = -1;
-  std::string out;
-  std::string err;
-};
+using Outcome = testing_util::SplitCommandResult;
 
 class RunCommandTest : public ::testing::Test {
  protected:
@@ -39,14 +36,7 @@ class RunCommandTest : public ::testing::Test {
   void TearDown() override { fs::remove_all(dir_); }
 
   Outcome Run(const std::string& arguments) const {
-    const std::string command = std::string(ARUCOSLAM_BINARY) + " " + arguments + " > " +
-                                (dir_ / "stdout").string() + " 2> " + (dir_ / "stderr").string();
-    const int raw = std::system(command.c_str());
-    Outcome outcome;
-    outcome.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    outcome.out = ReadTextFile(dir_ / "stdout");
-    outcome.err = ReadTextFile(dir_ / "stderr");
-    return outcome;
+    return testing_util::RunArucoslamSplit(arguments, dir_);
   }
 
   fs::path dir_;

@@ -33,6 +33,7 @@
 
 #include "arucoslam/eval/association.h"
 #include "arucoslam/eval/pose_error.h"
+#include "arucoslam/exe/command_test_util.h"
 #include "arucoslam/io/calibration.h"
 #include "arucoslam/io/path_json.h"
 #include "arucoslam/io/trajectory_io.h"
@@ -46,11 +47,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Outcome {
-  int status = -1;
-  std::string out;
-  std::string err;
-};
+using Outcome = testing_util::SplitCommandResult;
 
 std::string ReadText(const fs::path& path) {
   std::ifstream stream(path);
@@ -199,14 +196,7 @@ class BagEndToEndTest : public ::testing::Test {
   }
 
   static Outcome Run(const std::string& arguments) {
-    const std::string command = std::string(ARUCOSLAM_BINARY) + " " + arguments + " > " +
-                                (dir_ / "stdout").string() + " 2> " + (dir_ / "stderr").string();
-    const int raw = std::system(command.c_str());
-    Outcome outcome;
-    outcome.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    outcome.out = ReadText(dir_ / "stdout");
-    outcome.err = ReadText(dir_ / "stderr");
-    return outcome;
+    return testing_util::RunArucoslamSplit(arguments, dir_);
   }
 
   static fs::path dir_;
