@@ -1,9 +1,9 @@
 // `arucoslam run`: monocular SLAM over a sequence (EuRoC layout, TUM RGB-D folder, KITTI
 // odometry folder, image folder, video file or one image topic of a ROS 1 bag) or a live
-// camera -> trajectory.tum,
-// keyframes.tum, map.ply, stats.json (and with markers markers.json: the known markers and the
-// ones mapped online) in one output folder; map reuse: --save-map writes the map file after the
-// run, --load-map starts from one, --localize-only tracks against it without changing it.
+// camera -> trajectory.tum, keyframes.tum, map.ply, stats.json (and with markers
+// markers.json: the known markers and the ones mapped online) in one output folder; map reuse:
+// --save-map writes the map file after the run, --load-map starts from one, --localize-only
+// tracks against it without changing it.
 #include <atomic>
 #include <csignal>
 #include <cstdio>
@@ -111,8 +111,7 @@ std::unique_ptr<FrameSource> OpenSource(const RunArgs& args) {
   CameraSourceOptions camera_options;
   camera_options.stop = &g_stop_requested;
   // V4L2 for device paths and camera indices; anything else (a stream URL) as OpenCV sees fit.
-  const bool index =
-      !args.device.empty() && args.device.find_first_not_of("0123456789") == std::string::npos;
+  const bool index = args.device.find_first_not_of("0123456789") == std::string::npos;
   camera_options.api = args.device.starts_with("/dev/") || index ? cv::CAP_V4L2 : cv::CAP_ANY;
   return std::make_unique<CameraSource>(args.device, ReadCameraModel(args.camera), camera_options);
 }

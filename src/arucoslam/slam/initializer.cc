@@ -4,8 +4,8 @@
 
 #include <Eigen/SVD>
 #include <algorithm>
-#include <functional>
 #include <cmath>
+#include <functional>
 #include <stdexcept>
 
 #include "arucoslam/feature/feature_grid.h"
@@ -201,12 +201,11 @@ InitializationResult ChooseMotion(const InitializerOptions& options, Initializat
                 "homography has no translation solution");
   }
   // Each candidate that explains points is sharpened by a few Sampson iterations (the linear
-  // model is biased by noise; kept unless it then explains clearly fewer points). The
-  // candidates that agree best with the epipolar geometry of all matches then compete on the
-  // points they place in front of both cameras. Compared on that count alone, a car's true
-  // forward motion lost to the road plane's twin solution (translation along the plane's
-  // normal): its epipole lies in the image, where noise flips the depth of many points, yet
-  // the points off the plane follow its epipolar lines and not the twin's.
+  // model is biased by noise; kept unless it then explains clearly fewer points), and its
+  // epipolar support among the matches off the plane is counted. Counting points in front of
+  // both cameras alone favours a plane's twin motion (translation along the plane's normal)
+  // over a forward motion, whose epipole in the image lets noise flip the depth of many
+  // points; the matches off the plane follow only the true motion's epipolar lines.
   std::vector<Rigid3> motions = candidates;
   std::vector<MotionEvaluation> evaluations;
   int max_support = 0;
@@ -279,19 +278,6 @@ InitializationResult ChooseMotion(const InitializerOptions& options, Initializat
   std::vector<double> parallaxes_deg;
   for (double p : chosen.parallaxes_rad) parallaxes_deg.push_back(p * kDegPerRad);
   result.median_parallax_deg = Median(parallaxes_deg);
-  const std::string summary = fmt::format(
-      "{} model, {} inliers, best motion {} consistent, second {}, median parallax "
-      "{:.2f} deg",
-      kind == TwoViewModelKind::kHomography ? "H" : "F", model.num_inliers, chosen.consistent,
-      second_consistent, result.median_parallax_deg);
-  if (second_consistent > options.ambiguity_ratio * chosen.consistent) {
-    return Fail(std::move(result), InitFailure::kAmbiguous, summary);
-  }
-  const double needed = std::max<double>(options.min_triangulated,
-                                         options.min_triangulated_fraction * model.num_inliers);
-  if (chosen.consistent < needed) {
-    return Fail(std::move(result), InitFailure::kTooFewTriangulated, summary);
-  }
   // The parallax of the min_triangulated-th widest point: far points (a street ahead of a car)
   // keep the median near zero however wide the baseline, while the nearer points that hold
   // the map's geometry already see it from well-separated views.
@@ -300,6 +286,19 @@ InitializationResult ChooseMotion(const InitializerOptions& options, Initializat
   const std::size_t rank = static_cast<std::size_t>(options.min_triangulated) - 1;
   const double parallax_deg =
       widest_first.empty() ? 0.0 : widest_first[std::min(rank, widest_first.size() - 1)];
+  const std::string summary = fmt::format(
+      "{} model, {} inliers, best motion {} consistent, second {}, median parallax "
+      "{:.2f} deg, {}th widest {:.2f} deg",
+      kind == TwoViewModelKind::kHomography ? "H" : "F", model.num_inliers, chosen.consistent,
+      second_consistent, result.median_parallax_deg, options.min_triangulated, parallax_deg);
+  if (second_consistent > options.ambiguity_ratio * chosen.consistent) {
+    return Fail(std::move(result), InitFailure::kAmbiguous, summary);
+  }
+  const double needed = std::max<double>(options.min_triangulated,
+                                         options.min_triangulated_fraction * model.num_inliers);
+  if (chosen.consistent < needed) {
+    return Fail(std::move(result), InitFailure::kTooFewTriangulated, summary);
+  }
   if (parallax_deg < options.min_parallax_deg) {
     return Fail(std::move(result), InitFailure::kTooLittleParallax, summary);
   }
