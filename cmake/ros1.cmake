@@ -2,7 +2,7 @@
 # libimage-transport-dev and the message packages). Their CMake configs need catkin/ament
 # Python modules and rosbag_storage.pc requires a pluginlib.pc that Debian does not ship, so
 # headers and libraries are found directly. Defines the interface target arucoslam_ros1 and
-# sets ARUCOSLAM_WITH_ROS; without ROS it prints one line and the ros/ layer is skipped.
+# sets ARUCOSLAM_WITH_ROS; without ROS it prints one line and io/rosbag/ and ros/ are skipped.
 option(ARUCOSLAM_ROS "Build the ROS 1 layer (bag input, arucoslam_ros node) when ROS is found" ON)
 set(ARUCOSLAM_WITH_ROS OFF)
 if(ARUCOSLAM_ROS)
@@ -40,16 +40,16 @@ if(ARUCOSLAM_ROS)
   find_program(ROS1_MASTER_PROGRAM rosmaster)
   if(_ros_missing)
     list(JOIN _ros_missing ", " _ros_missing_text)
-    message(STATUS "ROS 1 not found (missing ${_ros_missing_text}): skipping the ros/ layer, "
-                   "bag input and the arucoslam_ros node (scripts/install-deps.sh installs them)")
+    message(STATUS "ROS 1 not found (missing ${_ros_missing_text}): skipping io/rosbag/, "
+                   "the ros/ layer and the arucoslam_ros node (scripts/install-deps.sh installs them)")
   else()
     list(REMOVE_DUPLICATES _ros_include_dirs)
     add_library(arucoslam_ros1 INTERFACE)
     target_include_directories(arucoslam_ros1 SYSTEM INTERFACE ${_ros_include_dirs})
     target_link_libraries(arucoslam_ros1 INTERFACE ${_ros_libraries})
     set(ARUCOSLAM_WITH_ROS ON)
-    message(STATUS "ROS 1 found: building the ros/ layer (bag input, arucoslam_ros node)")
+    message(STATUS "ROS 1 found: building io/rosbag/ (bag input) and the ros/ layer (arucoslam_ros node)")
   endif()
 else()
-  message(STATUS "ARUCOSLAM_ROS is OFF: skipping the ros/ layer, bag input and the arucoslam_ros node")
+  message(STATUS "ARUCOSLAM_ROS is OFF: skipping io/rosbag/ (bag input), the ros/ layer and the arucoslam_ros node")
 endif()

@@ -4,7 +4,7 @@
 
 #include "arucoslam/util/error.h"
 #ifdef ARUCOSLAM_WITH_ROS
-#include "arucoslam/ros/bag_reader.h"
+#include "arucoslam/io/rosbag/bag_reader.h"
 #endif
 
 namespace arucoslam {

@@ -1,4 +1,4 @@
-// `run`'s ROS 1 bag input: a FrameSource over one image topic of a bag (ros/bag_reader.h). In a
+// `run`'s ROS 1 bag input: a FrameSource over one image topic of a bag (io/rosbag/bag_reader.h). In a
 // build without ROS, opening a bag is an InputError that says so.
 #pragma once
 

@@ -37,8 +37,8 @@
 #include "arucoslam/io/calibration.h"
 #include "arucoslam/io/path_json.h"
 #include "arucoslam/io/trajectory_io.h"
-#include "arucoslam/ros/camera_info.h"
-#include "arucoslam/ros/image_messages.h"
+#include "arucoslam/io/rosbag/camera_info.h"
+#include "arucoslam/io/rosbag/image_messages.h"
 
 extern char** environ;
 

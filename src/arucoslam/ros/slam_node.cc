@@ -5,8 +5,8 @@
 
 #include "arucoslam/io/calibration.h"
 #include "arucoslam/io/marker_map_json.h"
-#include "arucoslam/ros/camera_info.h"
-#include "arucoslam/ros/image_messages.h"
+#include "arucoslam/io/rosbag/camera_info.h"
+#include "arucoslam/io/rosbag/image_messages.h"
 #include "arucoslam/ros/map_messages.h"
 #include "arucoslam/ros/pose_messages.h"
 #include "arucoslam/util/error.h"

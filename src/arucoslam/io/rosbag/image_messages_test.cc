@@ -1,4 +1,4 @@
-#include "arucoslam/ros/image_messages.h"
+#include "arucoslam/io/rosbag/image_messages.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "arucoslam/ros/bag_reader.h"
+#include "arucoslam/io/rosbag/bag_reader.h"
 
 #include <gtest/gtest.h>
 #include <rosbag/bag.h>
@@ -8,8 +8,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "arucoslam/io/calibration.h"
-#include "arucoslam/ros/camera_info.h"
-#include "arucoslam/ros/image_messages.h"
+#include "arucoslam/io/rosbag/camera_info.h"
+#include "arucoslam/io/rosbag/image_messages.h"
 #include "arucoslam/util/error.h"
 
 namespace arucoslam {

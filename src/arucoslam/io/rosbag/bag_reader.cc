@@ -1,4 +1,4 @@
-#include "arucoslam/ros/bag_reader.h"
+#include "arucoslam/io/rosbag/bag_reader.h"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -14,8 +14,8 @@
 #include <utility>
 
 #include "arucoslam/io/calibration.h"
-#include "arucoslam/ros/camera_info.h"
-#include "arucoslam/ros/image_messages.h"
+#include "arucoslam/io/rosbag/camera_info.h"
+#include "arucoslam/io/rosbag/image_messages.h"
 #include "arucoslam/util/error.h"
 
 namespace arucoslam {

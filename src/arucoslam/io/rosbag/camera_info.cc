@@ -1,4 +1,4 @@
-#include "arucoslam/ros/camera_info.h"
+#include "arucoslam/io/rosbag/camera_info.h"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
