@@ -15,13 +15,7 @@ namespace arucoslam::testing_util {
 
 // Writes the world to dir/world and the camera to dir/camera.yaml.
 inline SplitCommandResult MakeAisleWorld(const std::filesystem::path& dir) {
-  CameraModel camera;
-  camera.width = 320;
-  camera.height = 240;
-  camera.fx = camera.fy = 230.0;
-  camera.cx = 159.5;
-  camera.cy = 119.5;
-  WriteEuRoCSensorYaml(camera, dir / "camera.yaml");
+  WriteEuRoCSensorYaml(PinholeCamera(320, 240, 230.0), dir / "camera.yaml");
   return RunArucoslamSplit(
       "world factory --seed 3 --aisles 1 --aisle-length 8 "
       "--markers-per-dock 4 --marker-size 0.3 --out " +
@@ -43,6 +37,16 @@ inline SplitCommandResult SimulateAisle(const std::filesystem::path& dir, const 
                                (dir / "camera.yaml").string() + " --msaa 1 --quiet --out " +
                                (dir / ("seq_" + name)).string(),
                            dir);
+}
+
+// Empties `dir` and makes the world, the camera and seq_a in it: the aisle from x = 6 m to
+// 12.5 m, teach run (128 frames).
+inline SplitCommandResult MakeAisleTeachSequence(const std::filesystem::path& dir) {
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const SplitCommandResult world = MakeAisleWorld(dir);
+  if (world.status != 0) return world;
+  return SimulateAisle(dir, "a", 6.0, "teach");
 }
 
 }  // namespace arucoslam::testing_util

@@ -22,11 +22,7 @@ class RunConfigTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = fs::temp_directory_path() / ("arucoslam_run_config_test_" + std::to_string(getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-    SplitCommandResult result = testing_util::MakeAisleWorld(dir_);
-    ASSERT_EQ(result.status, 0) << result.err;
-    result = testing_util::SimulateAisle(dir_, "a", 6.0, "teach");
+    SplitCommandResult result = testing_util::MakeAisleTeachSequence(dir_);
     ASSERT_EQ(result.status, 0) << result.err;
   }
   static void TearDownTestSuite() { fs::remove_all(dir_); }

@@ -30,11 +30,7 @@ class RunMapReuseTest : public ::testing::Test {
   // (the default camera at half size), no MSAA.
   static void SetUpTestSuite() {
     dir_ = fs::temp_directory_path() / ("arucoslam_map_reuse_test_" + std::to_string(getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-    SplitCommandResult result = testing_util::MakeAisleWorld(dir_);
-    ASSERT_EQ(result.status, 0) << result.err;
-    result = testing_util::SimulateAisle(dir_, "a", 6.0, "teach");
+    SplitCommandResult result = testing_util::MakeAisleTeachSequence(dir_);
     ASSERT_EQ(result.status, 0) << result.err;
     result = testing_util::SimulateAisle(dir_, "b", 9.0, "repeat");
     ASSERT_EQ(result.status, 0) << result.err;
