@@ -12,6 +12,7 @@
 #include "arucoslam/io/marker_map_json.h"
 #include "arucoslam/markers/camera_locator.h"
 #include "arucoslam/markers/detector.h"
+#include "arucoslam/markers/options_visit.h"
 #include "arucoslam/markers/preprocess.h"
 #include "arucoslam/util/error.h"
 
@@ -31,12 +32,12 @@ struct LocateArgs {
 };
 
 CornerRefinement RefinementFromName(const std::string& name) {
-  if (name == "none") return CornerRefinement::kNone;
-  if (name == "subpix") return CornerRefinement::kSubpix;
-  if (name == "contour") return CornerRefinement::kContour;
-  if (name == "apriltag") return CornerRefinement::kAprilTag;
-  throw InputError("--refinement",
-                   "unknown refinement '" + name + "' (accepted: none, subpix, contour, apriltag)");
+  std::string accepted;
+  for (const auto& [refinement, refinement_name] : kCornerRefinementNames) {
+    if (refinement_name == name) return refinement;
+    accepted += (accepted.empty() ? "" : ", ") + std::string(refinement_name);
+  }
+  throw InputError("--refinement", "unknown refinement '" + name + "' (accepted: " + accepted + ")");
 }
 
 nlohmann::json PoseJson(const Rigid3& pose) {

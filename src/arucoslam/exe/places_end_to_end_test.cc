@@ -160,7 +160,7 @@ TEST_F(PlacesEndToEnd, ClosingTheLoopAtLeastHalvesTheError) {
                                            "--seed 3 --texture medium --aisles 1 --aisle-length 6",
                                            0.0, true);
   const Dataset dataset = Dataset::Open(sequence);
-  // FAST down to 5 grey levels as `arucoslam run` sets it (exe/run_command.cc).
+  // FAST down to 5 grey levels as `arucoslam run` sets it (DefaultRunOptions, exe/slam_run.cc).
   const int fast_threshold = 5;
   const RunOutcome open = RunSystem(dataset, *vocabulary_, false, 0, 0, fast_threshold);
   const RunOutcome closed = RunSystem(dataset, *vocabulary_, true, 0, 0, fast_threshold);

@@ -3,7 +3,8 @@
 // camera -> trajectory.tum, keyframes.tum, map.ply, stats.json (and with markers
 // markers.json: the known markers and the ones mapped online) in one output folder; map reuse:
 // --save-map writes the map file after the run, --load-map starts from one, --localize-only
-// tracks against it without changing it.
+// tracks against it without changing it. The SLAM's options: run's defaults, then a config file
+// (--config, as --print-config writes it), then the flags that set options.
 #include <atomic>
 #include <csignal>
 #include <cstdio>
@@ -19,6 +20,7 @@
 #include "arucoslam/exe/slam_run.h"
 #include "arucoslam/io/calibration.h"
 #include "arucoslam/io/camera_source.h"
+#include "arucoslam/io/config_file.h"
 #include "arucoslam/io/frame_source.h"
 #include "arucoslam/io/marker_map_json.h"
 #include "arucoslam/util/error.h"
@@ -32,6 +34,8 @@ struct RunArgs {
   std::string device;  // a live camera instead of a dataset
   std::size_t max_frames = 0;
   std::string out;
+  std::string config;         // options file read over run's defaults
+  bool print_config = false;  // write the options as YAML to stdout instead of running
   std::string camera;
   std::string image_topic;        // ROS bag only
   std::string camera_info_topic;  // ROS bag only
@@ -43,7 +47,9 @@ struct RunArgs {
   bool ground_vehicle = false;
   bool blocking = false;
   bool quiet = false;
-  int num_features = 1000;
+  int num_features = 0;  // used when given (num_features_given): overrides the config file
+  bool num_features_given = false;
+  bool marker_size_given = false;  // --marker-size given: overrides the config file
   double rate_hz = 0.0;
   std::string save_map;
   std::string load_map;
@@ -116,17 +122,43 @@ std::unique_ptr<FrameSource> OpenSource(const RunArgs& args) {
   return std::make_unique<CameraSource>(args.device, ReadCameraModel(args.camera), camera_options);
 }
 
-int RunSlam(const RunArgs& args) {
-  if (args.num_features < 100) {
+// The options `run` starts from without flags or config file: what --print-config writes.
+SystemOptions RunDefaults() {
+  return DefaultRunOptions(/*blocking=*/false, /*vocabulary=*/nullptr, /*loop_closing=*/true);
+}
+
+// Run's defaults < the config file < the flags given that set options. Data (marker map,
+// vocabulary) come later.
+SystemOptions RunOptions(const RunArgs& args) {
+  if (args.num_features_given && args.num_features < 100) {
     throw InputError("--features",
                      "expected at least 100, got " + std::to_string(args.num_features));
   }
-  if (args.rate_hz < 0.0) throw InputError("--rate", "expected a rate >= 0 Hz");
-  CheckMapArgs(args);
-  if (!(args.marker_size_m >= 0.0)) {
+  if (args.marker_size_given && !(args.marker_size_m >= 0.0)) {
     throw InputError("--marker-size",
                      "expected a side >= 0 m, got " + std::to_string(args.marker_size_m));
   }
+  SystemOptions options = RunDefaults();
+  if (!args.config.empty()) ReadSystemOptions(args.config, options);
+  if (args.blocking) options.blocking = true;
+  if (args.no_loop_closing) options.places.loop_closing = false;
+  if (args.num_features_given) options.extractor.num_features = args.num_features;
+  if (args.marker_size_given) options.marker_mapping.unknown_marker_size_m = args.marker_size_m;
+  if (args.ground_vehicle && !options.marker_mapping.ground_plane_prior) {
+    options.marker_mapping.ground_plane_prior = GroundPlanePriorOptions{};
+  }
+  return options;
+}
+
+int RunSlam(const RunArgs& args) {
+  SystemOptions options = RunOptions(args);
+  if (args.print_config) {
+    std::fputs(SystemOptionsYaml(options).c_str(), stdout);
+    return kExitOk;
+  }
+  if (args.out.empty()) throw InputError("--out", "missing: the output folder is required");
+  if (args.rate_hz < 0.0) throw InputError("--rate", "expected a rate >= 0 Hz");
+  CheckMapArgs(args);
   if (std::filesystem::exists(args.out) && !std::filesystem::is_directory(args.out)) {
     throw InputError(args.out, "exists and is not a directory");
   }
@@ -135,22 +167,19 @@ int RunSlam(const RunArgs& args) {
   std::optional<std::filesystem::path> markers_path = source->markers_path();
   if (!args.markers.empty()) markers_path = args.markers;
   if (args.no_markers) markers_path.reset();
-  if (args.ground_vehicle && !markers_path) {  // before the vocabulary's load: fail fast
-    throw InputError("--ground-vehicle", "needs markers: the plane is held in their world frame");
+  if (options.marker_mapping.ground_plane_prior && !markers_path) {  // before the vocabulary
+    throw InputError(args.ground_vehicle ? "--ground-vehicle"
+                                         : args.config + ": marker_mapping.ground_plane_prior",
+                     "needs markers: the plane is held in their world frame");
   }
   const std::filesystem::path vocabulary =
       args.vocabulary.empty() ? DefaultVocabularyPath() : std::filesystem::path(args.vocabulary);
-  SystemOptions options = DefaultRunOptions(
-      args.blocking, std::make_shared<const Vocabulary>(Vocabulary::Load(vocabulary)),
-      !args.no_loop_closing);
-  options.extractor.num_features = args.num_features;
+  options.vocabulary = std::make_shared<const Vocabulary>(Vocabulary::Load(vocabulary));
   if (markers_path) {
     options.marker_map = ReadMarkerMapJson(*markers_path);
     options.detector.dictionary = options.marker_map->dictionary;
-    options.marker_mapping.unknown_marker_size_m = args.marker_size_m;
   }
   const bool markers = options.marker_map.has_value();
-  if (args.ground_vehicle) options.marker_mapping.ground_plane_prior = GroundPlanePriorOptions{};
   MapReuse reuse;
   if (!args.load_map.empty()) LoadMapForRun(args.load_map, source->camera(), reuse);
   reuse.localize_only = args.localize_only;
@@ -196,8 +225,15 @@ void AddRunCommand(CLI::App& app, int& exit_status) {
                   "namespace + /camera_info; --camera replaces it)");
   run->add_option("--max-frames", args->max_frames, "stop after this many frames (0: all)")
       ->capture_default_str();
-  run->add_option("--out", args->out, "output folder (replaced only when the run succeeds)")
-      ->required();
+  run->add_option("--out", args->out,
+                  "output folder, required (replaced only when the run succeeds)");
+  run->add_option("--config", args->config,
+                  "options file (YAML, as --print-config writes it; keys left out keep their "
+                  "defaults); --blocking, --features, --marker-size, --no-loop-closing and "
+                  "--ground-vehicle override it");
+  run->add_flag("--print-config", args->print_config,
+                "write the options this run would use (defaults, --config, flags) as commented "
+                "YAML to stdout and exit");
   run->add_option("--camera", args->camera,
                   "calibration file (EuRoC sensor.yaml, OpenCV YAML/XML, Kalibr camchain, ROS "
                   "camera_info or ORB-SLAM3 settings); required for TUM, image folders, videos "
@@ -218,14 +254,20 @@ void AddRunCommand(CLI::App& app, int& exit_status) {
   run->add_option("--markers", args->markers,
                   "known markers (markers.json) to use instead of the sequence's; markers it "
                   "lacks are mapped online and written to markers.json (fixed: false)");
-  run->add_option("--marker-size", args->marker_size_m,
-                  "side in metres of markers the marker map lacks (0: that of its first marker)")
-      ->capture_default_str();
+  const SystemOptions defaults = RunDefaults();
+  args->marker_size_m = defaults.marker_mapping.unknown_marker_size_m;
+  CLI::Option* marker_size =
+      run->add_option("--marker-size", args->marker_size_m,
+                      "side in metres of markers the marker map lacks (0: that of its first "
+                      "marker); overrides the config file")
+          ->capture_default_str();
   run->add_flag("--blocking", args->blocking,
                 "track and map each frame in turn on one thread (deterministic)");
   run->add_flag("--quiet", args->quiet, "no progress line");
-  run->add_option("--features", args->num_features, "ORB features per image")
-      ->capture_default_str();
+  args->num_features = defaults.extractor.num_features;
+  CLI::Option* features = run->add_option("--features", args->num_features,
+                                          "ORB features per image; overrides the config file")
+                              ->capture_default_str();
   run->add_option("--rate", args->rate_hz,
                   "frame rate in Hz giving the timestamps of an image folder (0: from the "
                   "camera file) or a video (0: the container's timestamps)")
@@ -238,7 +280,11 @@ void AddRunCommand(CLI::App& app, int& exit_status) {
   run->add_flag("--localize-only", args->localize_only,
                 "with --load-map: track against the loaded map without adding keyframes or "
                 "points");
-  run->callback([args, &exit_status] { exit_status = RunSlam(*args); });
+  run->callback([args, features, marker_size, &exit_status] {
+    args->num_features_given = features->count() > 0;
+    args->marker_size_given = marker_size->count() > 0;
+    exit_status = RunSlam(*args);
+  });
 }
 
 }  // namespace arucoslam

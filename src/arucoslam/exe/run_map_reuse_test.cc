@@ -9,12 +9,10 @@
 #include <filesystem>
 #include <map>
 #include <string>
-#include <tuple>
 
+#include "arucoslam/exe/aisle_sequence_test_util.h"
 #include "arucoslam/exe/command_test_util.h"
-#include "arucoslam/io/calibration.h"
 #include "arucoslam/io/map_file.h"
-#include "arucoslam/io/path_json.h"
 #include "arucoslam/io/trajectory_io.h"
 #include "arucoslam/util/files.h"
 
@@ -32,32 +30,10 @@ class RunMapReuseTest : public ::testing::Test {
   // (the default camera at half size), no MSAA.
   static void SetUpTestSuite() {
     dir_ = fs::temp_directory_path() / ("arucoslam_map_reuse_test_" + std::to_string(getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-    SplitCommandResult result =
-        Run("world factory --seed 3 --aisles 1 --aisle-length 8 --markers-per-dock 4 "
-            "--marker-size 0.3 --out " + (dir_ / "world").string());
+    SplitCommandResult result = testing_util::MakeAisleTeachSequence(dir_);
     ASSERT_EQ(result.status, 0) << result.err;
-    CameraModel camera;
-    camera.width = 320;
-    camera.height = 240;
-    camera.fx = camera.fy = 230.0;
-    camera.cx = 159.5;
-    camera.cy = 119.5;
-    WriteEuRoCSensorYaml(camera, dir_ / "camera.yaml");
-    PathSpec spec = ReadPathJson(dir_ / "world" / "path.json");
-    spec.options.camera_rate_hz = 15.0;
-    for (const auto& [name, start, run] : {std::tuple{"a", 6.0, "teach"},
-                                           std::tuple{"b", 9.0, "repeat"}}) {
-      spec.waypoints = {{start, 4.6, 0.0}, {12.5, 4.6, 0.0}};
-      const fs::path path = dir_ / (std::string("path_") + name + ".json");
-      WritePathJson(path, spec);
-      result = Run("simulate --world " + (dir_ / "world" / "world.sdf").string() + " --path " +
-                   path.string() + " --run " + run + " --camera " + (dir_ / "camera.yaml").string() +
-                   " --msaa 1 --quiet --out " +
-                   (dir_ / (std::string("seq_") + name)).string());
-      ASSERT_EQ(result.status, 0) << result.err;
-    }
+    result = testing_util::SimulateAisle(dir_, "b", 9.0, "repeat");
+    ASSERT_EQ(result.status, 0) << result.err;
   }
   static void TearDownTestSuite() { fs::remove_all(dir_); }
 

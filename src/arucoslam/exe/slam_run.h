@@ -41,9 +41,10 @@ struct SlamRunResult {
   std::vector<Eigen::Vector3d> map_points;  // as written to map.ply
 };
 
-// The System options every SLAM run of the tools starts from (`run`, `experiments`): blocking
-// or threaded, the given vocabulary with loop closing on or off, and the extractor's FAST floor
-// for bland walls.
+// The System options every SLAM run of the tools starts from (`run`, `experiments`, the ROS
+// node): blocking or threaded, the given vocabulary with loop closing on or off, and the
+// extractor's FAST floor for bland walls (5, not the library's 7, which the pipeline tests
+// measure with). `run --print-config` writes them (threaded, loop closing on).
 SystemOptions DefaultRunOptions(bool blocking, std::shared_ptr<const Vocabulary> vocabulary,
                                 bool loop_closing);
 

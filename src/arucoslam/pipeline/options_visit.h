@@ -1,0 +1,175 @@
+// VisitOptions for SystemOptions and the pipeline layer's options structs: each field once,
+// with its comment (the protocol: util/options_visit.h). `arucoslam run --print-config` and
+// `--config` write and read SystemOptions through these (io/config_file.h).
+#pragma once
+
+#include "arucoslam/pipeline/place_recognition.h"
+#include "arucoslam/pipeline/pose_consistency.h"
+#include "arucoslam/pipeline/system.h"
+#include "arucoslam/pipeline/world_motion_prior.h"
+#include "arucoslam/pipeline/world_rotation_vote.h"
+#include "arucoslam/slam/options_visit.h"
+
+namespace arucoslam {
+
+template <class Visitor>
+void VisitOptions(WorldMotionPriorOptions& o, Visitor& visit) {
+  visit("max_age_s", o.max_age_s, "a prediction needs a fix at most this old, seconds");
+  visit("min_span_s", o.min_span_s, "... and an earlier one at least this before it, seconds");
+  visit("max_span_s", o.max_span_s, "... and at most this before it, seconds");
+}
+
+template <class Visitor>
+void VisitOptions(WorldRotationVoteOptions& o, Visitor& visit) {
+  visit("agreement_deg", o.agreement_deg, "two views' hypotheses agree within this, degrees");
+  visit("min_support", o.min_support, "views agreeing with the winner, itself included");
+  visit("min_margin", o.min_margin, "the winner's support over the best rival's (> 1)");
+  visit("max_views", o.max_views, "views kept, the newest");
+}
+
+template <class Visitor>
+void VisitOptions(PoseConsistencyOptions& o, Visitor& visit) {
+  visit("max_offset_m", o.max_offset_m,
+        "a frame farther than this from the path between its keyframes is dropped, metres");
+  visit("max_keyframe_gap_s", o.max_keyframe_gap_s,
+        "checked between keyframes at most this far apart in time, seconds");
+}
+
+template <class Visitor>
+void VisitOptions(PlaceRecognitionOptions& o, Visitor& visit) {
+  visit("loop_closing", o.loop_closing,
+        "detect and close loops (run --no-loop-closing: false; relocalisation stays)");
+  visit("database", o.database, "the keyframe database");
+  visit("relocalizer", o.relocalizer, "relocalisation of lost tracking from the database");
+  visit("detector", o.detector, "loop detection");
+  visit("closer", o.closer, "loop correction");
+  visit("global_bundle_adjustment", o.global_bundle_adjustment,
+        "a global bundle adjustment after each closed loop");
+  visit("global_ba", o.global_ba, "that global bundle adjustment");
+  visit("loop_queue_capacity", o.loop_queue_capacity,
+        "mapped keyframes waiting for the loop-closing thread");
+  visit("max_marker_candidates", o.max_marker_candidates,
+        "lost frame, no database pose: keyframes that saw its markers tried (0: off)");
+}
+
+// SystemOptions' fields in the order of system.h, where each is explained at length. Not
+// here: the data `marker_map` (markers.json, run --markers), which also gives
+// detector.dictionary, and `vocabulary` (run --vocabulary).
+template <class Visitor>
+void VisitOptions(SystemOptions& o, Visitor& visit) {
+  visit("extractor", o.extractor, "ORB extraction");
+  visit("initializer", o.initializer, "two-view map initialisation");
+  visit("initial_map", o.initial_map, "refinement and test of the initial map");
+  visit("tracker", o.tracker, "frame tracking");
+  visit("keyframes", o.keyframes, "keyframe decision");
+  visit("mapper", o.mapper, "local mapping");
+  visit("blocking", o.blocking,
+        "true: each frame tracked and mapped in turn on one thread, deterministic (run "
+        "--blocking); false: local mapping on its own thread");
+  visit("mapper_queue_capacity", o.mapper_queue_capacity,
+        "keyframes waiting for the mapping thread");
+  visit("yield_bundle_adjustment", o.yield_bundle_adjustment,
+        "threaded: a local BA ends early once another keyframe waits");
+  visit("synchronous_young_map_keyframes", o.synchronous_young_map_keyframes,
+        "threaded: tracking waits for mapping while the map has at most this many keyframes");
+  visit("synchronous_until_aligned", o.synchronous_until_aligned,
+        "threaded, marker map: ... and while the map is not aligned to the marker world");
+  visit("max_initialization_gap_s", o.max_initialization_gap_s,
+        "the initialisation reference is replaced after this long, seconds");
+  visit("reset_max_keyframes", o.reset_max_keyframes,
+        "lost with at most this many keyframes: the map is discarded and initialised again");
+  visit("detector", o.detector, "marker detection (with a marker map)");
+  visit("marker_search", o.marker_search, "where each image's markers are searched");
+  visit("locator", o.locator, "camera pose from the markers (LocateCamera)");
+  visit("alignment", o.alignment, "keypoint map to marker world alignment (Sim3)");
+  visit("max_marker_rms_px", o.max_marker_rms_px,
+        "a marker location is used with a corner RMS at most this, pixels");
+  visit("max_marker_distance_sides", o.max_marker_distance_sides,
+        "... and its nearest marker at most this many marker sides away");
+  visit("resolve_ambiguity_by_motion", o.resolve_ambiguity_by_motion,
+        "an ambiguous one-marker location settled by a motion prediction");
+  visit("ambiguity_gates", o.ambiguity_gates, "gates of that prediction");
+  visit("fix_motion", o.fix_motion, "constant-velocity prediction from recent marker fixes");
+  visit("resolve_ambiguity_by_map_rotation", o.resolve_ambiguity_by_map_rotation,
+        "unaligned map: ambiguous markers settled by the map's voted world orientation");
+  visit("rotation_vote", o.rotation_vote, "that vote");
+  visit("map_rotation_gates", o.map_rotation_gates, "gates of the voted orientation");
+  visit("min_alignment_anchors", o.min_alignment_anchors,
+        "world alignment waits for this many keyframes with a marker location");
+  visit("min_alignment_baseline_m", o.min_alignment_baseline_m,
+        "... whose camera centres span at least this, metres");
+  visit("max_alignment_rms_m", o.max_alignment_rms_m,
+        "alignment refused above this anchor residual, metres");
+  visit("max_alignment_scale", o.max_alignment_scale,
+        "a first alignment with a larger scale is refused (collapsed map)");
+  visit("max_realignment_anchors", o.max_realignment_anchors,
+        "realigned each time the anchors double, up to this many");
+  visit("min_frames_between_anchor_keyframes", o.min_frames_between_anchor_keyframes,
+        "before alignment a frame with a marker location becomes a keyframe after this many");
+  visit("marker_reset_lost_frames", o.marker_reset_lost_frames,
+        "aligned map lost this many frames while markers give poses: a new map");
+  visit("max_marker_disagreement_m", o.max_marker_disagreement_m,
+        "a keypoint pose farther than this from the frame's marker location is wrong, metres");
+  visit("correct_drift_beyond_gate", o.correct_drift_beyond_gate,
+        "such a disagreement after steady tracking is drift, corrected with the markers");
+  visit("min_drift_interval_s", o.min_drift_interval_s,
+        "drift when tracked without a break this long since the markers agreed, seconds");
+  visit("max_drift_step_m", o.max_drift_step_m,
+        "sooner: drift only when the disagreement grew at most this since the last, metres");
+  visit("max_drift_correction_frames", o.max_drift_correction_frames,
+        "frames that wait for a drift correction");
+  visit("markers_in_local_ba", o.markers_in_local_ba,
+        "aligned map: marker observations in local and global BA");
+  visit("map_unknown_markers", o.map_unknown_markers, "aligned map: map markers it lacks");
+  visit("whole_map_marker_adjustment", o.whole_map_marker_adjustment,
+        "aligned map: one BA of the whole map with the markers when it closes and at Finish");
+  visit("merge_closed_maps", o.merge_closed_maps,
+        "a closed aligned map is merged into the next map once that one is aligned");
+  visit("min_locating_marker_keyframes", o.min_locating_marker_keyframes,
+        "mapped markers seen by this many keyframes locate frames (0: never)");
+  visit("marker_mapping", o.marker_mapping, "mapping of markers absent from the marker map");
+  visit("marker_drift_correction", o.marker_drift_correction,
+        "pose-graph correction of the aligned map when a keyframe's markers disagree");
+  visit("marker_priors_in_loops", o.marker_priors_in_loops,
+        "loops in the aligned map corrected with the marker priors");
+  visit("min_marker_correction_m", o.min_marker_correction_m,
+        "a correction needs a disagreement beyond this, metres ...");
+  visit("marker_correction_sigmas", o.marker_correction_sigmas,
+        "... and beyond this many standard deviations of the marker pose");
+  visit("marker_priors", o.marker_priors, "keyframe marker locations as priors");
+  visit("marker_correction_graph", o.marker_correction_graph,
+        "the pose graph of marker corrections");
+  visit("bridge_tracking_gaps", o.bridge_tracking_gaps,
+        "a gap between two aligned maps bridged by a constant-velocity prediction");
+  visit("bridge_motion", o.bridge_motion, "that prediction");
+  visit("bridge_position_sigma_m", o.bridge_position_sigma_m,
+        "its position sigma, metres, plus ...");
+  visit("bridge_position_sigma_per_s", o.bridge_position_sigma_per_s,
+        "... this per second of gap, metres per second");
+  visit("bridge_rotation_sigma_rad", o.bridge_rotation_sigma_rad,
+        "its rotation sigma, radians, plus ...");
+  visit("bridge_rotation_sigma_per_s", o.bridge_rotation_sigma_per_s,
+        "... this per second of gap, radians per second");
+  visit("bridge_in_bundle_adjustment", o.bridge_in_bundle_adjustment,
+        "the bridge's camera centre stays a prior in whole-map bundle adjustments");
+  visit("bridge_max_acceleration_m_s2", o.bridge_max_acceleration_m_s2,
+        "its sigma there grows with this x gap^2 / 2, metres per second squared");
+  visit("places", o.places, "place recognition: relocalisation and loops (with a vocabulary)");
+  visit("new_map_after_lost_s", o.new_map_after_lost_s,
+        "lost this long and not relocalised: a new map, seconds");
+  visit("min_marker_init_baseline_m", o.min_marker_init_baseline_m,
+        "marker initialisation: two marker locations at least this far apart, metres");
+  visit("min_marker_init_parallax_deg", o.min_marker_init_parallax_deg,
+        "... and this median parallax of the triangulated points, degrees");
+  visit("max_backfill_frames", o.max_backfill_frames,
+        "frames before initialisation tracked backwards against the new map (0: none)");
+  visit("refine_frame_poses", o.refine_frame_poses,
+        "at Finish every tracked frame is optimised again against the final map");
+  visit("refine_min_inlier_fraction", o.refine_min_inlier_fraction,
+        "its new pose is kept with at least this fraction of its matches still inliers");
+  visit("drop_inconsistent_poses", o.drop_inconsistent_poses,
+        "frames far off the path between their keyframes are left out of the trajectory");
+  visit("pose_consistency", o.pose_consistency, "that test");
+}
+
+}  // namespace arucoslam
