@@ -17,6 +17,7 @@ struct FactoryArgs {
   FactoryOptions options;
   std::string texture = "medium";
   std::string markers = "on";
+  std::string motion = "robot";
   std::string out;
 };
 
@@ -40,7 +41,9 @@ void RunFactory(FactoryArgs args) {
   if (!(o.camera_height_m >= 0.3 && o.camera_height_m <= 1.0)) {
     throw InputError("--camera-height", "expected 0.3 to 1.0 metres");
   }
-  const FactoryWorld world = BuildFactoryWorld(o);
+  const PathMotion motion = PathMotionFromName(args.motion, "--motion");
+  FactoryWorld world = BuildFactoryWorld(o);
+  world.default_route.options = WithMotion(world.default_route.options, motion);
   const std::vector<RouteSample> route = PlanRoute(world.default_route);
   StagedDirectory out(args.out);
   WriteFactoryWorld(world, out.path());
@@ -104,6 +107,11 @@ void AddWorldCommand(CLI::App& app, int& exit_status) {
   factory
       ->add_option("--camera-height", args->options.camera_height_m,
                    "height of the route's camera and of the marker centres, metres")
+      ->capture_default_str();
+  factory
+      ->add_option("--motion", args->motion,
+                   "how path.json drives the route: robot (1 m/s, 30 Hz) or car (up to 6 m/s, "
+                   "10 Hz, as in driving datasets)")
       ->capture_default_str();
   factory->callback([args, &exit_status] {
     RunFactory(*args);

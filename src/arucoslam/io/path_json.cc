@@ -34,7 +34,7 @@ struct OptionField {
 const std::vector<OptionField>& OptionFields() {
   static const std::vector<OptionField> fields = {
       {"turn_radius_m", &PathOptions::turn_radius_m, 0.0, 1e3, true},
-      {"max_speed_m_s", &PathOptions::max_speed_m_s, 0.0, 1.0, true},
+      {"max_speed_m_s", &PathOptions::max_speed_m_s, 0.0, 30.0, true},
       {"max_acceleration_m_s2", &PathOptions::max_acceleration_m_s2, 0.0, 10.0, true},
       {"max_lateral_acceleration_m_s2", &PathOptions::max_lateral_acceleration_m_s2, 0.0, 10.0,
        true},

@@ -21,7 +21,7 @@ struct PathWaypoint {
 // How waypoints become a drive and camera poses. Defaults: a ground robot at walking pace.
 struct PathOptions {
   double turn_radius_m = 1.2;                  // default corner radius, metres (> 0)
-  double max_speed_m_s = 1.0;                  // top speed on straights, m/s (0, 1]
+  double max_speed_m_s = 1.0;                  // top speed on straights, m/s (0, 30]
   double max_acceleration_m_s2 = 0.5;          // along the path (start, stop, slow-downs), m/s^2
   double max_lateral_acceleration_m_s2 = 0.3;  // in turns: v^2 * curvature <= this, m/s^2
   double max_yaw_rate_rad_s = 0.7;             // in turns: v * curvature <= this, rad/s

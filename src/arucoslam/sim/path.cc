@@ -301,6 +301,34 @@ std::vector<TimedPose> GenerateCameraPath(const PathSpec& spec, PathRun run) {
   return poses;
 }
 
+PathMotion PathMotionFromName(const std::string& name, const std::string& source) {
+  if (name == "robot") return PathMotion::kRobot;
+  if (name == "car") return PathMotion::kCar;
+  throw InputError(source, "expected robot or car, found '" + name + "'");
+}
+
+PathOptions WithMotion(PathOptions options, PathMotion motion) {
+  const PathOptions robot;
+  if (motion == PathMotion::kRobot) {
+    options.turn_radius_m = robot.turn_radius_m;
+    options.max_speed_m_s = robot.max_speed_m_s;
+    options.max_acceleration_m_s2 = robot.max_acceleration_m_s2;
+    options.max_lateral_acceleration_m_s2 = robot.max_lateral_acceleration_m_s2;
+    options.max_yaw_rate_rad_s = robot.max_yaw_rate_rad_s;
+    options.camera_rate_hz = robot.camera_rate_hz;
+    return options;
+  }
+  // Town driving as in KITTI's odometry sequences: up to 6 m/s, 0.6 m between frames at
+  // 10 Hz, turns at up to 3.4 degrees per frame.
+  options.turn_radius_m = 3.0;
+  options.max_speed_m_s = 6.0;
+  options.max_acceleration_m_s2 = 2.5;
+  options.max_lateral_acceleration_m_s2 = 3.0;
+  options.max_yaw_rate_rad_s = 0.6;
+  options.camera_rate_hz = 10.0;
+  return options;
+}
+
 double RouteDuration(const std::vector<RouteSample>& route) {
   return route.empty() ? 0.0 : route.back().time_s;
 }

@@ -2,6 +2,7 @@
 // speed profile) and its repeat run, sampled at camera rate as world_from_cam poses.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "arucoslam/geometry/rigid3.h"
@@ -38,6 +39,15 @@ std::vector<RouteSample> PlanRoute(const PathSpec& spec);
 
 // Camera poses at options.camera_rate_hz from t = 0 to the end of the route (at rest).
 std::vector<TimedPose> GenerateCameraPath(const PathSpec& spec, PathRun run);
+
+// How the camera moves along a route: a ground robot at walking pace (the PathOptions
+// defaults, 30 Hz) or a car (several m/s, 10 Hz: large motion between frames, as in driving).
+enum class PathMotion { kRobot, kCar };
+// "robot" or "car"; throws InputError(`source`, ...) for any other name.
+PathMotion PathMotionFromName(const std::string& name, const std::string& source);
+// `options` with the speed, acceleration, turn and camera-rate limits of `motion` (height,
+// pitch, vibration, repeat deviation and seed kept).
+PathOptions WithMotion(PathOptions options, PathMotion motion);
 
 // Duration (s) and length (m) of the route, for summaries.
 double RouteDuration(const std::vector<RouteSample>& route);

@@ -57,6 +57,35 @@ TEST(PathTest, SpeedStaysWithinLimitsAndSlowsInTurns) {
   EXPECT_LE(max_pose_speed, 1.0 + 0.02);  // the repeat's weave adds at most ~1%
 }
 
+TEST(PathTest, CarMotionMovesFarBetweenFramesAtTenHertz) {
+  PathSpec spec = LoopSpec();
+  spec.options = WithMotion(spec.options, PathMotionFromName("car", "--motion"));
+  const std::vector<TimedPose> poses = GenerateCameraPath(spec, PathRun::kTeach);
+  ASSERT_GT(poses.size(), 10u);
+  double max_step = 0.0, max_yaw_step = 0.0;
+  for (std::size_t i = 1; i < poses.size(); ++i) {
+    EXPECT_NEAR(poses[i].time_s - poses[i - 1].time_s, 0.1, 1e-12);
+    max_step = std::max(
+        max_step,
+        (poses[i].world_from_cam.translation - poses[i - 1].world_from_cam.translation).norm());
+    double yaw = Heading(poses[i].world_from_cam) - Heading(poses[i - 1].world_from_cam);
+    yaw = std::remainder(yaw, 2.0 * kPi);
+    max_yaw_step = std::max(max_yaw_step, std::abs(yaw));
+  }
+  // Up to 6 m/s on the 20 m straight (reached after 7.2 m at 2.5 m/s^2): 0.6 m per frame.
+  EXPECT_GT(max_step, 0.55);
+  EXPECT_LE(max_step, 0.6 + 1e-9);
+  // Turns at most 0.6 rad/s: 3.4 degrees per frame (vibration adds no yaw).
+  EXPECT_LE(max_yaw_step, 0.06 + 1e-6);
+  EXPECT_GT(max_yaw_step, 0.03);
+
+  // Back to the robot's limits, and an unknown motion is refused by name.
+  const PathOptions robot = WithMotion(spec.options, PathMotion::kRobot);
+  EXPECT_EQ(robot.camera_rate_hz, PathOptions().camera_rate_hz);
+  EXPECT_EQ(robot.max_speed_m_s, PathOptions().max_speed_m_s);
+  EXPECT_THROW(PathMotionFromName("bicycle", "--motion"), InputError);
+}
+
 TEST(PathTest, AccelerationFromRestFollowsConstantAcceleration) {
   const std::vector<RouteSample> route = PlanRoute(LoopSpec());
   // s = a t^2 / 2 with a = 0.5 m/s^2 until 1 m/s (s = 1 m).
