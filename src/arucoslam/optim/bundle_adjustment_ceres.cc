@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "arucoslam/optim/bundle_adjustment.h"
+#include "arucoslam/optim/reprojection_cost_ceres.h"
 #include "arucoslam/optim/se3_manifold_ceres.h"
 #include "arucoslam/util/timing.h"
 
@@ -14,51 +15,10 @@ namespace arucoslam {
 namespace {
 
 using ceres_internal::kPoseSize;
-using ceres_internal::kPoseTangentSize;
 using ceres_internal::PoseFromBlock;
 using ceres_internal::PoseToBlock;
+using ceres_internal::ReprojectionCost;
 using ceres_internal::Se3LeftManifold;
-
-// Whitened reprojection residual r / sigma over a pose block and a point block.
-class ReprojectionCost : public ceres::SizedCostFunction<2, kPoseSize, 3> {
- public:
-  ReprojectionCost(const PinholeIntrinsics& intrinsics, const Eigen::Vector2d& pixel,
-                   double sigma_px)
-      : error_(intrinsics, pixel), inverse_sigma_(1.0 / sigma_px) {}
-
-  bool Evaluate(const double* const* parameters, double* residuals,
-                double** jacobians) const override {
-    const Rigid3 cam_from_world = PoseFromBlock(parameters[0]);
-    const Eigen::Vector3d p_in_world(parameters[1][0], parameters[1][1], parameters[1][2]);
-    Eigen::Vector2d residual;
-    PoseJacobian d_pose;
-    PointJacobian d_point;
-    const bool want = jacobians != nullptr;
-    if (!error_.Evaluate(cam_from_world, p_in_world, &residual, want ? &d_pose : nullptr,
-                         want ? &d_point : nullptr)) {
-      // Behind the camera: no information (flagged as an outlier after the solve).
-      residual.setZero();
-      d_pose.setZero();
-      d_point.setZero();
-    }
-    Eigen::Map<Eigen::Vector2d> whitened(residuals);
-    whitened = inverse_sigma_ * residual;
-    if (want && jacobians[0] != nullptr) {
-      Eigen::Map<Eigen::Matrix<double, 2, kPoseSize, Eigen::RowMajor>> j(jacobians[0]);
-      j.leftCols<kPoseTangentSize>() = inverse_sigma_ * d_pose;
-      j.col(kPoseTangentSize).setZero();
-    }
-    if (want && jacobians[1] != nullptr) {
-      Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> j(jacobians[1]);
-      j = inverse_sigma_ * d_point;
-    }
-    return true;
-  }
-
- private:
-  ReprojectionError error_;
-  double inverse_sigma_;
-};
 
 void FlagOutliers(const BundleAdjustmentOptions& options, const BundleAdjustmentProblem& problem,
                   BundleAdjustmentSummary* summary) {

@@ -10,6 +10,7 @@
 
 #include "arucoslam/markers/marker_pose.h"
 #include "arucoslam/optim/marker_bundle_adjustment.h"
+#include "arucoslam/optim/reprojection_cost_ceres.h"
 #include "arucoslam/optim/se3_manifold_ceres.h"
 #include "arucoslam/util/timing.h"
 
@@ -18,50 +19,12 @@ namespace {
 
 using ceres_internal::kPoseSize;
 using ceres_internal::PoseBlock;
-constexpr int kTangentSize = ceres_internal::kPoseTangentSize;
+using ceres_internal::ReprojectionCost;
+using ceres_internal::WritePoseJacobian;
 using LeftSe3Manifold = ceres_internal::Se3LeftManifold;
 
 Rigid3 FromBlock(const double* block) { return ceres_internal::PoseFromBlock(block); }
 PoseBlock ToBlock(const Rigid3& pose) { return ceres_internal::PoseToBlock(pose); }
-
-// Writes a whitened residual Jacobian (rows x 6) into a rows x 7 row-major Ceres block.
-template <int Rows>
-void WritePoseJacobian(const Eigen::Matrix<double, Rows, 6>& d, double scale, double* out) {
-  Eigen::Map<Eigen::Matrix<double, Rows, kPoseSize, Eigen::RowMajor>> j(out);
-  j.template leftCols<kTangentSize>() = scale * d;
-  j.col(kTangentSize).setZero();
-}
-
-class KeypointCost : public ceres::SizedCostFunction<2, kPoseSize, 3> {
- public:
-  KeypointCost(const PinholeIntrinsics& intrinsics, const Eigen::Vector2d& pixel, double sigma)
-      : error_(intrinsics, pixel), inverse_sigma_(1.0 / sigma) {}
-  bool Evaluate(const double* const* parameters, double* residuals,
-                double** jacobians) const override {
-    Eigen::Vector2d residual = Eigen::Vector2d::Zero();
-    PoseJacobian d_pose = PoseJacobian::Zero();
-    PointJacobian d_point = PointJacobian::Zero();
-    const bool want = jacobians != nullptr;
-    if (!error_.Evaluate(FromBlock(parameters[0]), Eigen::Map<const Eigen::Vector3d>(parameters[1]),
-                         &residual, want ? &d_pose : nullptr, want ? &d_point : nullptr)) {
-      residual.setZero();  // behind the camera: no information (an outlier after the solve)
-      d_pose.setZero();
-      d_point.setZero();
-    }
-    Eigen::Map<Eigen::Vector2d> whitened(residuals);
-    whitened = inverse_sigma_ * residual;
-    if (want && jacobians[0] != nullptr) WritePoseJacobian<2>(d_pose, inverse_sigma_, jacobians[0]);
-    if (want && jacobians[1] != nullptr) {
-      Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> j(jacobians[1]);
-      j = inverse_sigma_ * d_point;
-    }
-    return true;
-  }
-
- private:
-  ReprojectionError error_;
-  double inverse_sigma_;
-};
 
 class MarkerCornerCost : public ceres::SizedCostFunction<8, kPoseSize, kPoseSize> {
  public:
@@ -193,7 +156,7 @@ void AddResiduals(const MarkerBundleAdjustmentProblem& problem, ceres::Manifold*
     double* pose = blocks->poses[observation.pose_index].data();
     double* point = blocks->points[observation.point_index].data();
     ceres_problem->AddResidualBlock(
-        new KeypointCost(keypoints.intrinsics, observation.pixel, observation.sigma_px),
+        new ReprojectionCost(keypoints.intrinsics, observation.pixel, observation.sigma_px),
         keypoint_loss, pose, point);
     Use(pose, keypoints.poses[observation.pose_index].fixed, manifold,
         blocks->pose_used[observation.pose_index], ceres_problem);

@@ -32,6 +32,16 @@ inline void PoseToBlock(const Rigid3& pose, double* block) {
   std::copy(values.begin(), values.end(), block);
 }
 
+// Writes a residual's Jacobian w.r.t. the pose tangent (Rows x 6), times `scale`, into a
+// Rows x 7 row-major Ceres block: the first six columns, the seventh zero (see below).
+template <int Rows>
+void WritePoseJacobian(const Eigen::Matrix<double, Rows, kPoseTangentSize>& d, double scale,
+                       double* out) {
+  Eigen::Map<Eigen::Matrix<double, Rows, kPoseSize, Eigen::RowMajor>> j(out);
+  j.template leftCols<kPoseTangentSize>() = scale * d;
+  j.col(kPoseTangentSize).setZero();
+}
+
 // x + delta = Exp(delta) * x. The cost functions report their Jacobians directly w.r.t.
 // delta in the first six ambient columns (the seventh is zero), so PlusJacobian is [I6; 0]
 // and Ceres' product gives the tangent Jacobian exactly.
