@@ -9,6 +9,7 @@
 #include "arucoslam/optim/bundle_adjustment.h"
 #include "arucoslam/optim/reprojection_cost_ceres.h"
 #include "arucoslam/optim/se3_manifold_ceres.h"
+#include "arucoslam/optim/solve_ceres.h"
 #include "arucoslam/util/timing.h"
 
 namespace arucoslam {
@@ -140,21 +141,11 @@ BundleAdjustmentSummary SolveBundleAdjustment(const BundleAdjustmentOptions& opt
     return summary;
   }
 
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_SCHUR;
-  solver_options.linear_solver_ordering = blocks.SchurOrdering();
-  solver_options.max_num_iterations = options.max_iterations;
-  solver_options.function_tolerance = options.function_tolerance;
-  solver_options.num_threads = options.num_threads;
-  solver_options.logging_type = ceres::SILENT;
-  ceres_internal::StopRequestCallback stop(options.stop_requested,
-                                           options.min_iterations_before_stop);
-  stop.RegisterWith(&solver_options);
-  ceres::Solver::Summary ceres_summary;
-  ceres::Solve(solver_options, &ceres_problem, &ceres_summary);
-
-  ceres_internal::CopySolverSummary(ceres_summary, &summary);
-  summary.stopped_early = ceres_summary.termination_type == ceres::USER_SUCCESS;
+  ceres_internal::SolveOptions solve_options =
+      ceres_internal::BundleAdjustmentSolveOptions(options);
+  solve_options.linear_solver_type = ceres::DENSE_SCHUR;
+  solve_options.ordering = blocks.SchurOrdering();
+  ceres_internal::Solve(solve_options, &ceres_problem, &summary);
   if (summary.success) blocks.CopyTo(problem);
   summary.final_rms_px = ReprojectionRmsPixels(*problem);
   FlagOutliers(options, *problem, &summary);

@@ -12,6 +12,7 @@
 #include "arucoslam/optim/marker_bundle_adjustment.h"
 #include "arucoslam/optim/reprojection_cost_ceres.h"
 #include "arucoslam/optim/se3_manifold_ceres.h"
+#include "arucoslam/optim/solve_ceres.h"
 #include "arucoslam/util/timing.h"
 
 namespace arucoslam {
@@ -274,7 +275,6 @@ MarkerBundleAdjustmentSummary SolveMarkerBundleAdjustment(
     return summary;
   }
 
-  ceres::Solver::Options solver_options;
   // Points eliminated first; poses and markers form the reduced camera system.
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   for (std::size_t i = 0; i < blocks.points.size(); ++i) {
@@ -291,20 +291,11 @@ MarkerBundleAdjustmentSummary SolveMarkerBundleAdjustment(
     ordering->AddElementToGroup(blocks.ground_up.data(), 1);
   }
   const bool has_points = ordering->NumElements() > 0 && ordering->GroupSize(0) > 0;
-  solver_options.linear_solver_type = has_points ? ceres::DENSE_SCHUR : ceres::DENSE_QR;
-  if (has_points) solver_options.linear_solver_ordering = ordering;
-  solver_options.max_num_iterations = options.solver.max_iterations;
-  solver_options.function_tolerance = options.solver.function_tolerance;
-  solver_options.num_threads = options.solver.num_threads;
-  solver_options.logging_type = ceres::SILENT;
-  ceres_internal::StopRequestCallback stop(options.solver.stop_requested,
-                                           options.solver.min_iterations_before_stop);
-  stop.RegisterWith(&solver_options);
-  ceres::Solver::Summary ceres_summary;
-  ceres::Solve(solver_options, &ceres_problem, &ceres_summary);
-
-  ceres_internal::CopySolverSummary(ceres_summary, &summary);
-  summary.stopped_early = ceres_summary.termination_type == ceres::USER_SUCCESS;
+  ceres_internal::SolveOptions solve_options =
+      ceres_internal::BundleAdjustmentSolveOptions(options.solver);
+  solve_options.linear_solver_type = has_points ? ceres::DENSE_SCHUR : ceres::DENSE_QR;
+  if (has_points) solve_options.ordering = ordering;
+  ceres_internal::Solve(solve_options, &ceres_problem, &summary);
   if (summary.success) blocks.CopyTo(problem);
   if (summary.success && ground_plane) {
     summary.ground_plane =

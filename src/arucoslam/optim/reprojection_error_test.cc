@@ -27,8 +27,7 @@ RandomView DrawView(std::mt19937& random) {
   for (int k = 0; k < 6; ++k) tangent[k] = unit(random);
   RandomView view;
   view.cam_from_world = Rigid3::Exp(tangent);
-  const Eigen::Vector3d p_in_cam(unit(random) * 2.0, unit(random) * 1.5,
-                                 3.5 + 2.5 * unit(random));
+  const Eigen::Vector3d p_in_cam(unit(random) * 2.0, unit(random) * 1.5, 3.5 + 2.5 * unit(random));
   view.p_in_world = view.cam_from_world.Inverse() * p_in_cam;
   view.observed = Eigen::Vector2d(300.0 + unit(random), 200.0 + unit(random));
   return view;
@@ -181,9 +180,9 @@ TEST(ReprojectionCostTest, JacobiansMatchNumericDifferencesOnTheManifold) {
     Eigen::Matrix<double, 2, 3> numeric_point;
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector3d delta = h * Eigen::Vector3d::Unit(k);
-      numeric_point.col(k) = (Residual(cost, pose, p_in_world + delta) -
-                              Residual(cost, pose, p_in_world - delta)) /
-                             (2.0 * h);
+      numeric_point.col(k) =
+          (Residual(cost, pose, p_in_world + delta) - Residual(cost, pose, p_in_world - delta)) /
+          (2.0 * h);
     }
     const Eigen::Matrix<double, 2, kPoseTangentSize> analytic_pose =
         evaluation.d_pose.leftCols<kPoseTangentSize>();
