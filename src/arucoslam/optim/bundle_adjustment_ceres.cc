@@ -21,25 +21,6 @@ using ceres_internal::PoseToBlock;
 using ceres_internal::ReprojectionCost;
 using ceres_internal::Se3LeftManifold;
 
-void FlagOutliers(const BundleAdjustmentOptions& options, const BundleAdjustmentProblem& problem,
-                  BundleAdjustmentSummary* summary) {
-  summary->outliers.assign(problem.observations.size(), false);
-  summary->num_outliers = 0;
-  for (std::size_t i = 0; i < problem.observations.size(); ++i) {
-    const auto& observation = problem.observations[i];
-    Eigen::Vector2d residual;
-    const bool in_front =
-        ReprojectionError(problem.intrinsics, observation.pixel)
-            .Evaluate(problem.poses[observation.pose_index].cam_from_world,
-                      problem.points[observation.point_index].p_in_world, &residual);
-    const double chi2 = residual.squaredNorm() / (observation.sigma_px * observation.sigma_px);
-    if (!in_front || chi2 > options.chi_square_threshold) {
-      summary->outliers[i] = true;
-      ++summary->num_outliers;
-    }
-  }
-}
-
 // Parameter blocks of a problem in Ceres' layout and which of them observations use.
 struct CeresBlocks {
   std::vector<std::array<double, kPoseSize>> poses;
@@ -114,15 +95,7 @@ void AddResiduals(const BundleAdjustmentProblem& problem, ceres::Manifold* manif
 BundleAdjustmentSummary SolveBundleAdjustment(const BundleAdjustmentOptions& options,
                                               BundleAdjustmentProblem* problem) {
   BundleAdjustmentSummary summary;
-  std::string reason;
-  if (!options.Check()) {
-    summary.message = "invalid options";
-    return summary;
-  }
-  if (!problem->Check(&reason)) {
-    summary.message = reason;
-    return summary;
-  }
+  if (!ceres_internal::InputsCheckOut(options, *problem, &summary)) return summary;
   const Stopwatch stopwatch;
   summary.initial_rms_px = ReprojectionRmsPixels(*problem);
 
@@ -134,12 +107,7 @@ BundleAdjustmentSummary SolveBundleAdjustment(const BundleAdjustmentOptions& opt
   Se3LeftManifold manifold;
   ceres::HuberLoss loss(options.huber_delta_px);
   AddResiduals(*problem, &manifold, &loss, &blocks, &ceres_problem);
-  summary.num_residual_blocks = ceres_problem.NumResidualBlocks();
-  if (summary.num_residual_blocks == 0) {
-    summary.success = true;
-    summary.message = "no observations";
-    return summary;
-  }
+  if (ceres_internal::NothingToSolve(ceres_problem, "no observations", &summary)) return summary;
 
   ceres_internal::SolveOptions solve_options =
       ceres_internal::BundleAdjustmentSolveOptions(options);
@@ -148,7 +116,8 @@ BundleAdjustmentSummary SolveBundleAdjustment(const BundleAdjustmentOptions& opt
   ceres_internal::Solve(solve_options, &ceres_problem, &summary);
   if (summary.success) blocks.CopyTo(problem);
   summary.final_rms_px = ReprojectionRmsPixels(*problem);
-  FlagOutliers(options, *problem, &summary);
+  summary.outliers =
+      FlagReprojectionOutliers(*problem, options.chi_square_threshold, &summary.num_outliers);
   summary.solve_seconds = stopwatch.ElapsedSeconds();
   return summary;
 }

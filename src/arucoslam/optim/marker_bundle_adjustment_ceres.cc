@@ -210,18 +210,8 @@ void FlagOutliers(const MarkerBundleAdjustmentOptions& options,
                   const MarkerBundleAdjustmentProblem& problem,
                   MarkerBundleAdjustmentSummary* summary) {
   const auto& keypoints = problem.keypoints;
-  summary->keypoint_outliers.assign(keypoints.observations.size(), false);
-  for (std::size_t i = 0; i < keypoints.observations.size(); ++i) {
-    const auto& observation = keypoints.observations[i];
-    Eigen::Vector2d residual;
-    const bool in_front =
-        ReprojectionError(keypoints.intrinsics, observation.pixel)
-            .Evaluate(keypoints.poses[observation.pose_index].cam_from_world,
-                      keypoints.points[observation.point_index].p_in_world, &residual);
-    const double chi2 = residual.squaredNorm() / (observation.sigma_px * observation.sigma_px);
-    summary->keypoint_outliers[i] = !in_front || chi2 > options.solver.chi_square_threshold;
-    summary->num_keypoint_outliers += summary->keypoint_outliers[i] ? 1 : 0;
-  }
+  summary->keypoint_outliers = FlagReprojectionOutliers(
+      keypoints, options.solver.chi_square_threshold, &summary->num_keypoint_outliers);
   summary->marker_outliers.assign(problem.marker_observations.size(), false);
   for (std::size_t i = 0; i < problem.marker_observations.size(); ++i) {
     const auto& observation = problem.marker_observations[i];
@@ -242,15 +232,7 @@ void FlagOutliers(const MarkerBundleAdjustmentOptions& options,
 MarkerBundleAdjustmentSummary SolveMarkerBundleAdjustment(
     const MarkerBundleAdjustmentOptions& options, MarkerBundleAdjustmentProblem* problem) {
   MarkerBundleAdjustmentSummary summary;
-  std::string reason;
-  if (!options.Check()) {
-    summary.message = "invalid options";
-    return summary;
-  }
-  if (!problem->Check(&reason)) {
-    summary.message = reason;
-    return summary;
-  }
+  if (!ceres_internal::InputsCheckOut(options, *problem, &summary)) return summary;
   const Stopwatch stopwatch;
   summary.initial_keypoint_rms_px = ReprojectionRmsPixels(problem->keypoints);
   summary.initial_marker_rms_px = MarkerReprojectionRmsPixels(*problem);
@@ -268,12 +250,7 @@ MarkerBundleAdjustmentSummary SolveMarkerBundleAdjustment(
   const bool ground_plane =
       problem->ground_plane_prior &&
       AddGroundPlanePrior(*problem->ground_plane_prior, &sphere, &blocks, &ceres_problem);
-  summary.num_residual_blocks = ceres_problem.NumResidualBlocks();
-  if (summary.num_residual_blocks == 0) {
-    summary.success = true;
-    summary.message = "no observations";
-    return summary;
-  }
+  if (ceres_internal::NothingToSolve(ceres_problem, "no observations", &summary)) return summary;
 
   // Points eliminated first; poses and markers form the reduced camera system.
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();

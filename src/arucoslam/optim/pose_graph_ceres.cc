@@ -128,15 +128,7 @@ void AddResiduals(const PoseGraphOptions& options, const PoseGraphProblem& probl
 
 PoseGraphSummary SolvePoseGraph(const PoseGraphOptions& options, PoseGraphProblem* problem) {
   PoseGraphSummary summary;
-  std::string reason;
-  if (!options.Check()) {
-    summary.message = "invalid options";
-    return summary;
-  }
-  if (!problem->Check(&reason)) {
-    summary.message = reason;
-    return summary;
-  }
+  if (!ceres_internal::InputsCheckOut(options, *problem, &summary)) return summary;
   const Stopwatch stopwatch;
   std::vector<NodeBlocks> blocks = MakeBlocks(*problem);
   ceres::Problem::Options problem_options;
@@ -144,10 +136,7 @@ PoseGraphSummary SolvePoseGraph(const PoseGraphOptions& options, PoseGraphProble
   ceres::Problem ceres_problem(problem_options);
   ceres::EigenQuaternionManifold quaternion_manifold;
   AddResiduals(options, *problem, &quaternion_manifold, &blocks, &ceres_problem);
-  summary.num_residual_blocks = ceres_problem.NumResidualBlocks();
-  if (summary.num_residual_blocks == 0) {
-    summary.success = true;
-    summary.message = "no edges or priors";
+  if (ceres_internal::NothingToSolve(ceres_problem, "no edges or priors", &summary)) {
     return summary;
   }
   ceres_internal::SolveOptions solve_options;

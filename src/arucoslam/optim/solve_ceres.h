@@ -6,6 +6,7 @@
 
 #include <functional>
 #include <memory>
+#include <string>
 
 #include "arucoslam/optim/bundle_adjustment.h"
 
@@ -24,6 +25,33 @@ struct SolveOptions {
   std::function<bool()> stop_requested;
   int min_iterations_before_stop = 1;
 };
+
+// Before a solve: false, with the reason in summary->message, when `options` or `problem`
+// (optim/ types with Check) do not check out.
+template <typename Options, typename Problem, typename Summary>
+bool InputsCheckOut(const Options& options, const Problem& problem, Summary* summary) {
+  std::string reason;
+  if (!options.Check()) {
+    summary->message = "invalid options";
+    return false;
+  }
+  if (!problem.Check(&reason)) {
+    summary->message = reason;
+    return false;
+  }
+  return true;
+}
+
+// After the residuals are added: records their number in `summary` and, when there are none,
+// marks it a success with `message` and returns true (nothing to solve).
+template <typename Summary>
+bool NothingToSolve(const ceres::Problem& problem, const char* message, Summary* summary) {
+  summary->num_residual_blocks = problem.NumResidualBlocks();
+  if (summary->num_residual_blocks != 0) return false;
+  summary->success = true;
+  summary->message = message;
+  return true;
+}
 
 // The solver settings of BundleAdjustmentOptions (iterations, tolerance, threads, stop
 // request) with `linear_solver_type` and `ordering` left at their defaults.
