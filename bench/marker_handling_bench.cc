@@ -25,7 +25,7 @@
 #include "arucoslam/markers/camera_locator.h"
 #include "arucoslam/markers/detector.h"
 #include "arucoslam/markers/detector_regions.h"
-#include "arucoslam/markers/detector_worker.h"
+#include "arucoslam/pipeline/marker_detector_worker.h"
 #include "arucoslam/pipeline/system.h"
 #include "arucoslam/util/timing.h"
 

@@ -2,7 +2,9 @@
 // (the protocol: util/options_visit.h). Config files are read and written from these.
 #pragma once
 
+#include "arucoslam/geometry/pose_consistency.h"
 #include "arucoslam/geometry/sim3_solver.h"
+#include "arucoslam/geometry/world_motion_prior.h"
 #include "arucoslam/util/options_visit.h"
 
 namespace arucoslam {
@@ -24,6 +26,21 @@ void VisitOptions(Sim3SolverOptions& o, Visitor& visit) {
   visit("min_scale", o.min_scale, "a smaller scale is no loop");
   visit("max_scale", o.max_scale, "a larger scale is no loop");
   visit("seed", o.seed, "random sampling seed (deterministic)");
+}
+
+template <class Visitor>
+void VisitOptions(WorldMotionPriorOptions& o, Visitor& visit) {
+  visit("max_age_s", o.max_age_s, "a prediction needs a fix at most this old, seconds");
+  visit("min_span_s", o.min_span_s, "... and an earlier one at least this before it, seconds");
+  visit("max_span_s", o.max_span_s, "... and at most this before it, seconds");
+}
+
+template <class Visitor>
+void VisitOptions(PoseConsistencyOptions& o, Visitor& visit) {
+  visit("max_offset_m", o.max_offset_m,
+        "a frame farther than this from the path between its keyframes is dropped, metres");
+  visit("max_keyframe_gap_s", o.max_keyframe_gap_s,
+        "checked between keyframes at most this far apart in time, seconds");
 }
 
 }  // namespace arucoslam

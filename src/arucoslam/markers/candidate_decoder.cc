@@ -6,22 +6,11 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
+#include "arucoslam/geometry/image_sampling.h"
 #include "arucoslam/markers/edge_refiner.h"
 
 namespace arucoslam {
 namespace {
-
-// Bilinear grey value at (x, y); the caller keeps (x, y) inside the image.
-double Bilinear(const cv::Mat& gray, double x, double y) {
-  x = std::clamp(x, 0.0, gray.cols - 1.001);
-  y = std::clamp(y, 0.0, gray.rows - 1.001);
-  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
-  const double ax = x - x0, ay = y - y0;
-  const uchar* row0 = gray.ptr<uchar>(y0);
-  const uchar* row1 = gray.ptr<uchar>(y0 + 1);
-  return (1 - ay) * ((1 - ax) * row0[x0] + ax * row0[x0 + 1]) +
-         ay * ((1 - ax) * row1[x0] + ax * row1[x0 + 1]);
-}
 
 // Otsu's threshold over a few values: the split maximising the between-class variance.
 double OtsuThreshold(std::vector<double> values) {
@@ -81,7 +70,7 @@ std::vector<double> SampleCells(const cv::Mat& gray, const std::array<cv::Point2
           const double v = row + options.ignored_margin_per_cell + span * (i + 0.5) / s;
           const cv::Vec3d p = h * cv::Vec3d(u, v, 1.0);
           if (p[2] <= 0.0) return {};
-          sum += Bilinear(gray, p[0] / p[2], p[1] / p[2]);
+          sum += BilinearGrey(gray, p[0] / p[2], p[1] / p[2]);
         }
       }
       values[(row + ring) * n + col + ring] = sum / (s * s);

@@ -5,21 +5,11 @@
 #include <optional>
 #include <vector>
 
+#include "arucoslam/geometry/image_sampling.h"
 #include "arucoslam/markers/line_fit.h"
 
 namespace arucoslam {
 namespace {
-
-double GreyAt(const cv::Mat& gray, double x, double y) {
-  x = std::clamp(x, 0.0, gray.cols - 1.001);
-  y = std::clamp(y, 0.0, gray.rows - 1.001);
-  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
-  const double ax = x - x0, ay = y - y0;
-  const uchar* row0 = gray.ptr<uchar>(y0);
-  const uchar* row1 = gray.ptr<uchar>(y0 + 1);
-  return (1 - ay) * ((1 - ax) * row0[x0] + ax * row0[x0 + 1]) +
-         ay * ((1 - ax) * row1[x0] + ax * row1[x0 + 1]);
-}
 
 // Fits the edge along side a->b whose outward normal is `outward`: at points spread along
 // the side, the grey profile across it is read and the dark-to-bright step located as the
@@ -41,7 +31,7 @@ std::optional<FittedLine> FitSide(const cv::Mat& gray, cv::Point2d a, cv::Point2
     const cv::Point2d p = a + t * (b - a);
     for (int k = -half - 1; k <= half + 1; ++k) {
       const cv::Point2d q = p + (k * step) * outward;
-      profile[k + half + 1] = GreyAt(gray, q.x, q.y);
+      profile[k + half + 1] = BilinearGrey(gray, q.x, q.y);
     }
     // Derivative over +-derivative_half_width_px (in steps of 0.25 px each way).
     const int reach = std::max(1, static_cast<int>(std::lround(derivative_half_width_px / step)));

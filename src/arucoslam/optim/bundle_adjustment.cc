@@ -53,6 +53,26 @@ double ReprojectionRmsPixels(const BundleAdjustmentProblem& problem) {
   return count > 0 ? std::sqrt(sum / count) : 0.0;
 }
 
+std::vector<bool> FlagReprojectionOutliers(const BundleAdjustmentProblem& problem,
+                                           double chi_square_threshold, int* num_outliers) {
+  std::vector<bool> outliers(problem.observations.size(), false);
+  *num_outliers = 0;
+  for (std::size_t i = 0; i < problem.observations.size(); ++i) {
+    const auto& observation = problem.observations[i];
+    Eigen::Vector2d residual;
+    const bool in_front =
+        ReprojectionError(problem.intrinsics, observation.pixel)
+            .Evaluate(problem.poses[observation.pose_index].cam_from_world,
+                      problem.points[observation.point_index].p_in_world, &residual);
+    const double chi2 = residual.squaredNorm() / (observation.sigma_px * observation.sigma_px);
+    if (!in_front || chi2 > chi_square_threshold) {
+      outliers[i] = true;
+      ++*num_outliers;
+    }
+  }
+  return outliers;
+}
+
 void VisitReprojectionResiduals(
     const BundleAdjustmentProblem& problem,
     const std::function<void(const BundleAdjustmentProblem::Observation&,

@@ -86,6 +86,10 @@ BundleAdjustmentSummary SolveBundleAdjustment(const BundleAdjustmentOptions& opt
 
 // Reprojection RMS in pixels over all observations in front of their camera.
 double ReprojectionRmsPixels(const BundleAdjustmentProblem& problem);
+// Per observation: true when it is behind its camera or its squared residual over sigma^2
+// exceeds `chi_square_threshold` (the outlier test after a solve); `num_outliers` counts them.
+std::vector<bool> FlagReprojectionOutliers(const BundleAdjustmentProblem& problem,
+                                           double chi_square_threshold, int* num_outliers);
 // Calls `visit(observation, residual_px)` for each observation in front of its camera.
 void VisitReprojectionResiduals(
     const BundleAdjustmentProblem& problem,

@@ -7,77 +7,19 @@
 #include <vector>
 
 #include "arucoslam/optim/bundle_adjustment.h"
+#include "arucoslam/optim/reprojection_cost_ceres.h"
 #include "arucoslam/optim/se3_manifold_ceres.h"
+#include "arucoslam/optim/solve_ceres.h"
 #include "arucoslam/util/timing.h"
 
 namespace arucoslam {
 namespace {
 
 using ceres_internal::kPoseSize;
-using ceres_internal::kPoseTangentSize;
 using ceres_internal::PoseFromBlock;
 using ceres_internal::PoseToBlock;
+using ceres_internal::ReprojectionCost;
 using ceres_internal::Se3LeftManifold;
-
-// Whitened reprojection residual r / sigma over a pose block and a point block.
-class ReprojectionCost : public ceres::SizedCostFunction<2, kPoseSize, 3> {
- public:
-  ReprojectionCost(const PinholeIntrinsics& intrinsics, const Eigen::Vector2d& pixel,
-                   double sigma_px)
-      : error_(intrinsics, pixel), inverse_sigma_(1.0 / sigma_px) {}
-
-  bool Evaluate(const double* const* parameters, double* residuals,
-                double** jacobians) const override {
-    const Rigid3 cam_from_world = PoseFromBlock(parameters[0]);
-    const Eigen::Vector3d p_in_world(parameters[1][0], parameters[1][1], parameters[1][2]);
-    Eigen::Vector2d residual;
-    PoseJacobian d_pose;
-    PointJacobian d_point;
-    const bool want = jacobians != nullptr;
-    if (!error_.Evaluate(cam_from_world, p_in_world, &residual, want ? &d_pose : nullptr,
-                         want ? &d_point : nullptr)) {
-      // Behind the camera: no information (flagged as an outlier after the solve).
-      residual.setZero();
-      d_pose.setZero();
-      d_point.setZero();
-    }
-    Eigen::Map<Eigen::Vector2d> whitened(residuals);
-    whitened = inverse_sigma_ * residual;
-    if (want && jacobians[0] != nullptr) {
-      Eigen::Map<Eigen::Matrix<double, 2, kPoseSize, Eigen::RowMajor>> j(jacobians[0]);
-      j.leftCols<kPoseTangentSize>() = inverse_sigma_ * d_pose;
-      j.col(kPoseTangentSize).setZero();
-    }
-    if (want && jacobians[1] != nullptr) {
-      Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> j(jacobians[1]);
-      j = inverse_sigma_ * d_point;
-    }
-    return true;
-  }
-
- private:
-  ReprojectionError error_;
-  double inverse_sigma_;
-};
-
-void FlagOutliers(const BundleAdjustmentOptions& options, const BundleAdjustmentProblem& problem,
-                  BundleAdjustmentSummary* summary) {
-  summary->outliers.assign(problem.observations.size(), false);
-  summary->num_outliers = 0;
-  for (std::size_t i = 0; i < problem.observations.size(); ++i) {
-    const auto& observation = problem.observations[i];
-    Eigen::Vector2d residual;
-    const bool in_front =
-        ReprojectionError(problem.intrinsics, observation.pixel)
-            .Evaluate(problem.poses[observation.pose_index].cam_from_world,
-                      problem.points[observation.point_index].p_in_world, &residual);
-    const double chi2 = residual.squaredNorm() / (observation.sigma_px * observation.sigma_px);
-    if (!in_front || chi2 > options.chi_square_threshold) {
-      summary->outliers[i] = true;
-      ++summary->num_outliers;
-    }
-  }
-}
 
 // Parameter blocks of a problem in Ceres' layout and which of them observations use.
 struct CeresBlocks {
@@ -153,15 +95,7 @@ void AddResiduals(const BundleAdjustmentProblem& problem, ceres::Manifold* manif
 BundleAdjustmentSummary SolveBundleAdjustment(const BundleAdjustmentOptions& options,
                                               BundleAdjustmentProblem* problem) {
   BundleAdjustmentSummary summary;
-  std::string reason;
-  if (!options.Check()) {
-    summary.message = "invalid options";
-    return summary;
-  }
-  if (!problem->Check(&reason)) {
-    summary.message = reason;
-    return summary;
-  }
+  if (!ceres_internal::InputsCheckOut(options, *problem, &summary)) return summary;
   const Stopwatch stopwatch;
   summary.initial_rms_px = ReprojectionRmsPixels(*problem);
 
@@ -173,31 +107,17 @@ BundleAdjustmentSummary SolveBundleAdjustment(const BundleAdjustmentOptions& opt
   Se3LeftManifold manifold;
   ceres::HuberLoss loss(options.huber_delta_px);
   AddResiduals(*problem, &manifold, &loss, &blocks, &ceres_problem);
-  summary.num_residual_blocks = ceres_problem.NumResidualBlocks();
-  if (summary.num_residual_blocks == 0) {
-    summary.success = true;
-    summary.message = "no observations";
-    return summary;
-  }
+  if (ceres_internal::NothingToSolve(ceres_problem, "no observations", &summary)) return summary;
 
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_SCHUR;
-  solver_options.linear_solver_ordering = blocks.SchurOrdering();
-  solver_options.max_num_iterations = options.max_iterations;
-  solver_options.function_tolerance = options.function_tolerance;
-  solver_options.num_threads = options.num_threads;
-  solver_options.logging_type = ceres::SILENT;
-  ceres_internal::StopRequestCallback stop(options.stop_requested,
-                                           options.min_iterations_before_stop);
-  stop.RegisterWith(&solver_options);
-  ceres::Solver::Summary ceres_summary;
-  ceres::Solve(solver_options, &ceres_problem, &ceres_summary);
-
-  ceres_internal::CopySolverSummary(ceres_summary, &summary);
-  summary.stopped_early = ceres_summary.termination_type == ceres::USER_SUCCESS;
+  ceres_internal::SolveOptions solve_options =
+      ceres_internal::BundleAdjustmentSolveOptions(options);
+  solve_options.linear_solver_type = ceres::DENSE_SCHUR;
+  solve_options.ordering = blocks.SchurOrdering();
+  ceres_internal::Solve(solve_options, &ceres_problem, &summary);
   if (summary.success) blocks.CopyTo(problem);
   summary.final_rms_px = ReprojectionRmsPixels(*problem);
-  FlagOutliers(options, *problem, &summary);
+  summary.outliers =
+      FlagReprojectionOutliers(*problem, options.chi_square_threshold, &summary.num_outliers);
   summary.solve_seconds = stopwatch.ElapsedSeconds();
   return summary;
 }

@@ -74,6 +74,27 @@ TEST(BundleAdjustmentTest, OptionsAndProblemChecks) {
   EXPECT_FALSE(summary.success);
 }
 
+// One camera at the origin, points 2 m ahead projecting onto the principal point (300, 200).
+TEST(BundleAdjustmentTest, FlagsObservationsBehindOrBeyondTheChiSquareGate) {
+  BundleAdjustmentProblem problem;
+  problem.intrinsics = {400.0, 400.0, 300.0, 200.0};
+  problem.poses.push_back({Rigid3(), false});
+  problem.points.push_back({Eigen::Vector3d(0.0, 0.0, 2.0), false});
+  problem.points.push_back({Eigen::Vector3d(0.0, 0.0, -2.0), false});
+  auto observe = [&](std::size_t point, double x_px, double sigma_px) {
+    problem.observations.push_back({0, point, Eigen::Vector2d(x_px, 200.0), sigma_px});
+  };
+  observe(0, 300.0, 1.0);  // exact
+  observe(0, 303.0, 1.0);  // 3 px at 1 px noise: chi-square 9
+  observe(0, 303.0, 2.0);  // 3 px at 2 px noise: chi-square 2.25
+  observe(1, 300.0, 1.0);  // behind the camera
+  int num_outliers = -1;
+  const std::vector<bool> outliers =
+      FlagReprojectionOutliers(problem, kChiSquare2Dof95, &num_outliers);
+  EXPECT_EQ(outliers, (std::vector<bool>{false, true, false, true}));
+  EXPECT_EQ(num_outliers, 2);
+}
+
 TEST(BundleAdjustmentTest, PerturbedSceneConvergesToTruth) {
   SyntheticSceneOptions scene_options;
   scene_options.noise_px = 0.5;

@@ -10,7 +10,9 @@
 
 #include "arucoslam/markers/marker_pose.h"
 #include "arucoslam/optim/marker_bundle_adjustment.h"
+#include "arucoslam/optim/reprojection_cost_ceres.h"
 #include "arucoslam/optim/se3_manifold_ceres.h"
+#include "arucoslam/optim/solve_ceres.h"
 #include "arucoslam/util/timing.h"
 
 namespace arucoslam {
@@ -18,50 +20,12 @@ namespace {
 
 using ceres_internal::kPoseSize;
 using ceres_internal::PoseBlock;
-constexpr int kTangentSize = ceres_internal::kPoseTangentSize;
+using ceres_internal::ReprojectionCost;
+using ceres_internal::WritePoseJacobian;
 using LeftSe3Manifold = ceres_internal::Se3LeftManifold;
 
 Rigid3 FromBlock(const double* block) { return ceres_internal::PoseFromBlock(block); }
 PoseBlock ToBlock(const Rigid3& pose) { return ceres_internal::PoseToBlock(pose); }
-
-// Writes a whitened residual Jacobian (rows x 6) into a rows x 7 row-major Ceres block.
-template <int Rows>
-void WritePoseJacobian(const Eigen::Matrix<double, Rows, 6>& d, double scale, double* out) {
-  Eigen::Map<Eigen::Matrix<double, Rows, kPoseSize, Eigen::RowMajor>> j(out);
-  j.template leftCols<kTangentSize>() = scale * d;
-  j.col(kTangentSize).setZero();
-}
-
-class KeypointCost : public ceres::SizedCostFunction<2, kPoseSize, 3> {
- public:
-  KeypointCost(const PinholeIntrinsics& intrinsics, const Eigen::Vector2d& pixel, double sigma)
-      : error_(intrinsics, pixel), inverse_sigma_(1.0 / sigma) {}
-  bool Evaluate(const double* const* parameters, double* residuals,
-                double** jacobians) const override {
-    Eigen::Vector2d residual = Eigen::Vector2d::Zero();
-    PoseJacobian d_pose = PoseJacobian::Zero();
-    PointJacobian d_point = PointJacobian::Zero();
-    const bool want = jacobians != nullptr;
-    if (!error_.Evaluate(FromBlock(parameters[0]), Eigen::Map<const Eigen::Vector3d>(parameters[1]),
-                         &residual, want ? &d_pose : nullptr, want ? &d_point : nullptr)) {
-      residual.setZero();  // behind the camera: no information (an outlier after the solve)
-      d_pose.setZero();
-      d_point.setZero();
-    }
-    Eigen::Map<Eigen::Vector2d> whitened(residuals);
-    whitened = inverse_sigma_ * residual;
-    if (want && jacobians[0] != nullptr) WritePoseJacobian<2>(d_pose, inverse_sigma_, jacobians[0]);
-    if (want && jacobians[1] != nullptr) {
-      Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> j(jacobians[1]);
-      j = inverse_sigma_ * d_point;
-    }
-    return true;
-  }
-
- private:
-  ReprojectionError error_;
-  double inverse_sigma_;
-};
 
 class MarkerCornerCost : public ceres::SizedCostFunction<8, kPoseSize, kPoseSize> {
  public:
@@ -193,7 +157,7 @@ void AddResiduals(const MarkerBundleAdjustmentProblem& problem, ceres::Manifold*
     double* pose = blocks->poses[observation.pose_index].data();
     double* point = blocks->points[observation.point_index].data();
     ceres_problem->AddResidualBlock(
-        new KeypointCost(keypoints.intrinsics, observation.pixel, observation.sigma_px),
+        new ReprojectionCost(keypoints.intrinsics, observation.pixel, observation.sigma_px),
         keypoint_loss, pose, point);
     Use(pose, keypoints.poses[observation.pose_index].fixed, manifold,
         blocks->pose_used[observation.pose_index], ceres_problem);
@@ -246,18 +210,8 @@ void FlagOutliers(const MarkerBundleAdjustmentOptions& options,
                   const MarkerBundleAdjustmentProblem& problem,
                   MarkerBundleAdjustmentSummary* summary) {
   const auto& keypoints = problem.keypoints;
-  summary->keypoint_outliers.assign(keypoints.observations.size(), false);
-  for (std::size_t i = 0; i < keypoints.observations.size(); ++i) {
-    const auto& observation = keypoints.observations[i];
-    Eigen::Vector2d residual;
-    const bool in_front =
-        ReprojectionError(keypoints.intrinsics, observation.pixel)
-            .Evaluate(keypoints.poses[observation.pose_index].cam_from_world,
-                      keypoints.points[observation.point_index].p_in_world, &residual);
-    const double chi2 = residual.squaredNorm() / (observation.sigma_px * observation.sigma_px);
-    summary->keypoint_outliers[i] = !in_front || chi2 > options.solver.chi_square_threshold;
-    summary->num_keypoint_outliers += summary->keypoint_outliers[i] ? 1 : 0;
-  }
+  summary->keypoint_outliers = FlagReprojectionOutliers(
+      keypoints, options.solver.chi_square_threshold, &summary->num_keypoint_outliers);
   summary->marker_outliers.assign(problem.marker_observations.size(), false);
   for (std::size_t i = 0; i < problem.marker_observations.size(); ++i) {
     const auto& observation = problem.marker_observations[i];
@@ -278,15 +232,7 @@ void FlagOutliers(const MarkerBundleAdjustmentOptions& options,
 MarkerBundleAdjustmentSummary SolveMarkerBundleAdjustment(
     const MarkerBundleAdjustmentOptions& options, MarkerBundleAdjustmentProblem* problem) {
   MarkerBundleAdjustmentSummary summary;
-  std::string reason;
-  if (!options.Check()) {
-    summary.message = "invalid options";
-    return summary;
-  }
-  if (!problem->Check(&reason)) {
-    summary.message = reason;
-    return summary;
-  }
+  if (!ceres_internal::InputsCheckOut(options, *problem, &summary)) return summary;
   const Stopwatch stopwatch;
   summary.initial_keypoint_rms_px = ReprojectionRmsPixels(problem->keypoints);
   summary.initial_marker_rms_px = MarkerReprojectionRmsPixels(*problem);
@@ -304,14 +250,8 @@ MarkerBundleAdjustmentSummary SolveMarkerBundleAdjustment(
   const bool ground_plane =
       problem->ground_plane_prior &&
       AddGroundPlanePrior(*problem->ground_plane_prior, &sphere, &blocks, &ceres_problem);
-  summary.num_residual_blocks = ceres_problem.NumResidualBlocks();
-  if (summary.num_residual_blocks == 0) {
-    summary.success = true;
-    summary.message = "no observations";
-    return summary;
-  }
+  if (ceres_internal::NothingToSolve(ceres_problem, "no observations", &summary)) return summary;
 
-  ceres::Solver::Options solver_options;
   // Points eliminated first; poses and markers form the reduced camera system.
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   for (std::size_t i = 0; i < blocks.points.size(); ++i) {
@@ -328,20 +268,11 @@ MarkerBundleAdjustmentSummary SolveMarkerBundleAdjustment(
     ordering->AddElementToGroup(blocks.ground_up.data(), 1);
   }
   const bool has_points = ordering->NumElements() > 0 && ordering->GroupSize(0) > 0;
-  solver_options.linear_solver_type = has_points ? ceres::DENSE_SCHUR : ceres::DENSE_QR;
-  if (has_points) solver_options.linear_solver_ordering = ordering;
-  solver_options.max_num_iterations = options.solver.max_iterations;
-  solver_options.function_tolerance = options.solver.function_tolerance;
-  solver_options.num_threads = options.solver.num_threads;
-  solver_options.logging_type = ceres::SILENT;
-  ceres_internal::StopRequestCallback stop(options.solver.stop_requested,
-                                           options.solver.min_iterations_before_stop);
-  stop.RegisterWith(&solver_options);
-  ceres::Solver::Summary ceres_summary;
-  ceres::Solve(solver_options, &ceres_problem, &ceres_summary);
-
-  ceres_internal::CopySolverSummary(ceres_summary, &summary);
-  summary.stopped_early = ceres_summary.termination_type == ceres::USER_SUCCESS;
+  ceres_internal::SolveOptions solve_options =
+      ceres_internal::BundleAdjustmentSolveOptions(options.solver);
+  solve_options.linear_solver_type = has_points ? ceres::DENSE_SCHUR : ceres::DENSE_QR;
+  if (has_points) solve_options.ordering = ordering;
+  ceres_internal::Solve(solve_options, &ceres_problem, &summary);
   if (summary.success) blocks.CopyTo(problem);
   if (summary.success && ground_plane) {
     summary.ground_plane =

@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "arucoslam/optim/pose_graph.h"
-#include "arucoslam/optim/se3_manifold_ceres.h"
 #include "arucoslam/optim/pose_graph_residuals.h"
+#include "arucoslam/optim/solve_ceres.h"
 #include "arucoslam/util/timing.h"
 
 namespace arucoslam {
@@ -128,15 +128,7 @@ void AddResiduals(const PoseGraphOptions& options, const PoseGraphProblem& probl
 
 PoseGraphSummary SolvePoseGraph(const PoseGraphOptions& options, PoseGraphProblem* problem) {
   PoseGraphSummary summary;
-  std::string reason;
-  if (!options.Check()) {
-    summary.message = "invalid options";
-    return summary;
-  }
-  if (!problem->Check(&reason)) {
-    summary.message = reason;
-    return summary;
-  }
+  if (!ceres_internal::InputsCheckOut(options, *problem, &summary)) return summary;
   const Stopwatch stopwatch;
   std::vector<NodeBlocks> blocks = MakeBlocks(*problem);
   ceres::Problem::Options problem_options;
@@ -144,22 +136,15 @@ PoseGraphSummary SolvePoseGraph(const PoseGraphOptions& options, PoseGraphProble
   ceres::Problem ceres_problem(problem_options);
   ceres::EigenQuaternionManifold quaternion_manifold;
   AddResiduals(options, *problem, &quaternion_manifold, &blocks, &ceres_problem);
-  summary.num_residual_blocks = ceres_problem.NumResidualBlocks();
-  if (summary.num_residual_blocks == 0) {
-    summary.success = true;
-    summary.message = "no edges or priors";
+  if (ceres_internal::NothingToSolve(ceres_problem, "no edges or priors", &summary)) {
     return summary;
   }
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-  solver_options.max_num_iterations = options.max_iterations;
-  solver_options.function_tolerance = options.function_tolerance;
-  solver_options.num_threads = options.num_threads;
-  solver_options.logging_type = ceres::SILENT;
-  ceres::Solver::Summary ceres_summary;
-  ceres::Solve(solver_options, &ceres_problem, &ceres_summary);
-
-  ceres_internal::CopySolverSummary(ceres_summary, &summary);
+  ceres_internal::SolveOptions solve_options;
+  solve_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  solve_options.max_iterations = options.max_iterations;
+  solve_options.function_tolerance = options.function_tolerance;
+  solve_options.num_threads = options.num_threads;
+  ceres_internal::Solve(solve_options, &ceres_problem, &summary);
   if (summary.success) {
     for (std::size_t n = 0; n < blocks.size(); ++n) {
       if (!blocks[n].used || problem->nodes[n].fixed) continue;

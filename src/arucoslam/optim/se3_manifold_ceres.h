@@ -1,12 +1,10 @@
-// Internal to optim/'s *_ceres.cc files: a pose stored as a Ceres block [qx qy qz qw tx ty tz],
-// the left-multiplicative SE(3) manifold on it, and the solver-summary copy they share.
+// Internal to optim/'s *_ceres.cc files: a pose stored as a Ceres block [qx qy qz qw tx ty tz]
+// and the left-multiplicative SE(3) manifold on it.
 #pragma once
 
 #include <ceres/ceres.h>
 
 #include <array>
-#include <functional>
-#include <utility>
 
 #include "arucoslam/geometry/rigid3.h"
 
@@ -30,6 +28,16 @@ inline PoseBlock PoseToBlock(const Rigid3& pose) {
 inline void PoseToBlock(const Rigid3& pose, double* block) {
   const PoseBlock values = PoseToBlock(pose);
   std::copy(values.begin(), values.end(), block);
+}
+
+// Writes a residual's Jacobian w.r.t. the pose tangent (Rows x 6), times `scale`, into a
+// Rows x 7 row-major Ceres block: the first six columns, the seventh zero (see below).
+template <int Rows>
+void WritePoseJacobian(const Eigen::Matrix<double, Rows, kPoseTangentSize>& d, double scale,
+                       double* out) {
+  Eigen::Map<Eigen::Matrix<double, Rows, kPoseSize, Eigen::RowMajor>> j(out);
+  j.template leftCols<kPoseTangentSize>() = scale * d;
+  j.col(kPoseTangentSize).setZero();
 }
 
 // x + delta = Exp(delta) * x. The cost functions report their Jacobians directly w.r.t.
@@ -61,39 +69,6 @@ class Se3LeftManifold : public ceres::Manifold {
     j.leftCols<kPoseTangentSize>().setIdentity();
     return true;
   }
-};
-
-// Copies what every optim/ summary reports of a Ceres solve (success, iterations, costs,
-// message) into `summary`, whose type has those fields.
-template <typename Summary>
-void CopySolverSummary(const ceres::Solver::Summary& ceres_summary, Summary* summary) {
-  summary->success = ceres_summary.IsSolutionUsable();
-  summary->num_iterations = static_cast<int>(ceres_summary.iterations.size()) - 1;
-  summary->initial_cost = ceres_summary.initial_cost;
-  summary->final_cost = ceres_summary.final_cost;
-  summary->message = ceres_summary.message;
-}
-
-// Ends a solve after an iteration once `stop_requested` says so (from iteration
-// `min_iteration` on): Ceres keeps the best iterate reached and reports USER_SUCCESS.
-class StopRequestCallback : public ceres::IterationCallback {
- public:
-  StopRequestCallback(std::function<bool()> stop_requested, int min_iteration)
-      : stop_requested_(std::move(stop_requested)), min_iteration_(min_iteration) {}
-  // Joins the solve's callbacks when a stop can be requested (nothing to ask otherwise).
-  void RegisterWith(ceres::Solver::Options* solver_options) {
-    if (stop_requested_) solver_options->callbacks.push_back(this);
-  }
-  ceres::CallbackReturnType operator()(const ceres::IterationSummary& iteration) override {
-    if (iteration.iteration >= min_iteration_ && stop_requested_()) {
-      return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
-    }
-    return ceres::SOLVER_CONTINUE;
-  }
-
- private:
-  std::function<bool()> stop_requested_;
-  int min_iteration_;
 };
 
 }  // namespace arucoslam::ceres_internal

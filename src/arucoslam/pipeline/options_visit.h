@@ -4,36 +4,10 @@
 #pragma once
 
 #include "arucoslam/pipeline/place_recognition.h"
-#include "arucoslam/pipeline/pose_consistency.h"
 #include "arucoslam/pipeline/system.h"
-#include "arucoslam/pipeline/world_motion_prior.h"
-#include "arucoslam/pipeline/world_rotation_vote.h"
 #include "arucoslam/slam/options_visit.h"
 
 namespace arucoslam {
-
-template <class Visitor>
-void VisitOptions(WorldMotionPriorOptions& o, Visitor& visit) {
-  visit("max_age_s", o.max_age_s, "a prediction needs a fix at most this old, seconds");
-  visit("min_span_s", o.min_span_s, "... and an earlier one at least this before it, seconds");
-  visit("max_span_s", o.max_span_s, "... and at most this before it, seconds");
-}
-
-template <class Visitor>
-void VisitOptions(WorldRotationVoteOptions& o, Visitor& visit) {
-  visit("agreement_deg", o.agreement_deg, "two views' hypotheses agree within this, degrees");
-  visit("min_support", o.min_support, "views agreeing with the winner, itself included");
-  visit("min_margin", o.min_margin, "the winner's support over the best rival's (> 1)");
-  visit("max_views", o.max_views, "views kept, the newest");
-}
-
-template <class Visitor>
-void VisitOptions(PoseConsistencyOptions& o, Visitor& visit) {
-  visit("max_offset_m", o.max_offset_m,
-        "a frame farther than this from the path between its keyframes is dropped, metres");
-  visit("max_keyframe_gap_s", o.max_keyframe_gap_s,
-        "checked between keyframes at most this far apart in time, seconds");
-}
 
 template <class Visitor>
 void VisitOptions(PlaceRecognitionOptions& o, Visitor& visit) {

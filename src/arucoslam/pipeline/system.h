@@ -18,19 +18,18 @@
 #include <vector>
 
 #include "arucoslam/feature/orb_extractor.h"
+#include "arucoslam/geometry/pose_consistency.h"
+#include "arucoslam/geometry/world_motion_prior.h"
 #include "arucoslam/map/map.h"
-#include "arucoslam/optim/essential_graph.h"
-#include "arucoslam/optim/marker_factors.h"
 #include "arucoslam/markers/camera_locator.h"
 #include "arucoslam/markers/detector.h"
 #include "arucoslam/markers/detector_regions.h"
-#include "arucoslam/markers/detector_worker.h"
 #include "arucoslam/markers/marker_map.h"
+#include "arucoslam/optim/essential_graph.h"
+#include "arucoslam/optim/marker_factors.h"
 #include "arucoslam/pipeline/bounded_queue.h"
+#include "arucoslam/pipeline/marker_detector_worker.h"
 #include "arucoslam/pipeline/place_recognition.h"
-#include "arucoslam/pipeline/pose_consistency.h"
-#include "arucoslam/pipeline/world_motion_prior.h"
-#include "arucoslam/pipeline/world_rotation_vote.h"
 #include "arucoslam/slam/initializer.h"
 #include "arucoslam/slam/keyframe_policy.h"
 #include "arucoslam/slam/local_mapper.h"
@@ -38,6 +37,7 @@
 #include "arucoslam/slam/marker_mapper.h"
 #include "arucoslam/slam/tracker.h"
 #include "arucoslam/slam/world_alignment.h"
+#include "arucoslam/slam/world_rotation_vote.h"
 #include "arucoslam/util/timing.h"
 
 namespace arucoslam {

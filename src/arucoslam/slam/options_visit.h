@@ -17,6 +17,7 @@
 #include "arucoslam/slam/relocalizer.h"
 #include "arucoslam/slam/tracker.h"
 #include "arucoslam/slam/world_alignment.h"
+#include "arucoslam/slam/world_rotation_vote.h"
 
 namespace arucoslam {
 
@@ -247,6 +248,14 @@ void VisitOptions(LoopCloserOptions& o, Visitor& visit) {
         "best covisible keyframes corrected with the current one");
   visit("essential_graph", o.essential_graph, "the pose-graph correction");
   visit("metric_map", o.metric_map, "rigid loops, SE(3) graph (set for a marker map)");
+}
+
+template <class Visitor>
+void VisitOptions(WorldRotationVoteOptions& o, Visitor& visit) {
+  visit("agreement_deg", o.agreement_deg, "two views' hypotheses agree within this, degrees");
+  visit("min_support", o.min_support, "views agreeing with the winner, itself included");
+  visit("min_margin", o.min_margin, "the winner's support over the best rival's (> 1)");
+  visit("max_views", o.max_views, "views kept, the newest");
 }
 
 }  // namespace arucoslam

@@ -1,4 +1,4 @@
-#include "arucoslam/pipeline/world_motion_prior.h"
+#include "arucoslam/geometry/world_motion_prior.h"
 
 #include <gtest/gtest.h>
 

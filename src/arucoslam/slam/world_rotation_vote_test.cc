@@ -1,7 +1,7 @@
 // WorldRotationVote on one-marker views located by LocateCamera from noisy projected corners:
 // a camera approaching markers on an end wall, its poses also given in a keypoint map's own
 // frame (turned, scaled, shifted, with a slow rotation drift).
-#include "arucoslam/pipeline/world_rotation_vote.h"
+#include "arucoslam/slam/world_rotation_vote.h"
 
 #include <gtest/gtest.h>
 

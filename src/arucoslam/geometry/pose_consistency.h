@@ -13,13 +13,12 @@ struct StampedPose {
   Rigid3 world_from_cam;
 };
 
-// A frame tracked with few inliers (a plain wall, a young map) can sit a metre off the
+// A frame tracked with few inliers (a plain wall, a young map) can sit far off the
 // keyframes it was tracked between while those keyframes, optimised with many views, are
-// right to decimetres: on the demo sequence such frames alternate at 30 Hz between two
-// places a metre apart. Between two keyframes at most max_keyframe_gap_s apart in time, a
-// camera cannot stray from the straight line joining them by more than their distance
-// apart (it moves smoothly); a frame farther than that and than max_offset_m from the point
-// of the line at its time is dropped.
+// right; such frames can alternate from one frame to the next between two places. Between
+// two keyframes at most max_keyframe_gap_s apart in time, a camera cannot stray from the
+// straight line joining them by more than their distance apart (it moves smoothly); a frame
+// farther than that and than max_offset_m from the point of the line at its time is dropped.
 struct PoseConsistencyOptions {
   double max_offset_m = 0.25;
   double max_keyframe_gap_s = 1.0;

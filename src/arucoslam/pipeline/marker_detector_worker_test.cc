@@ -1,4 +1,4 @@
-#include "arucoslam/markers/detector_worker.h"
+#include "arucoslam/pipeline/marker_detector_worker.h"
 
 #include <gtest/gtest.h>
 

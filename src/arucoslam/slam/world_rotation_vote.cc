@@ -1,4 +1,4 @@
-#include "arucoslam/pipeline/world_rotation_vote.h"
+#include "arucoslam/slam/world_rotation_vote.h"
 
 #include <cmath>
 #include <stdexcept>

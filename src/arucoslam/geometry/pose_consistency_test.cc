@@ -1,4 +1,4 @@
-#include "arucoslam/pipeline/pose_consistency.h"
+#include "arucoslam/geometry/pose_consistency.h"
 
 #include <gtest/gtest.h>
 
