@@ -3,7 +3,7 @@ BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
 
-.PHONY: all deps configure build build-binary test demo bench format clean
+.PHONY: all deps configure build build-binary test tsan demo bench format clean
 
 all: build
 
@@ -22,6 +22,11 @@ build-binary: configure
 
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j$(JOBS)
+	$(MAKE) tsan
+
+# ThreadSanitizer build (build-tsan/) of the threaded tests; `make test` runs it last.
+tsan: deps
+	scripts/tsan-tests.sh build-tsan
 
 demo: build-binary
 	$(BUILD)/bin/arucoslam demo --out out/demo
