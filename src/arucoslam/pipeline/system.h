@@ -56,19 +56,15 @@ struct SystemOptions {
   // Threaded mode: a local BA ends after its current iteration (at least the mapper's
   // min_iterations_before_stop) once another keyframe waits in the queue, so a new view gets
   // its points mapped without waiting for the BAs of the keyframes before it (ORB-SLAM's
-  // abort). Threaded world ATE on the 2 m wall-marker world 0.029-0.049 m in three runs instead
-  // of 0.14-0.28 m (BENCHMARKS.md). Blocking mode: no keyframe waits.
+  // abort). Blocking mode: no keyframe waits.
   bool yield_bundle_adjustment = true;
   // Threaded mode: while the map holds at most this many keyframes, tracking waits until
   // each new keyframe is mapped before it takes the next frame, as in blocking mode. A young
-  // map tracked ahead of its local BA drifts in scale: a map started after a loss on the
-  // demo sequence ended its first local BAs at 4-7 px RMS and lost four fifths of its scale
-  // before it saw a marker (blocking: 1.4-3.7 px). 0: tracking never waits.
+  // map tracked ahead of its local BA drifts in scale. 0: tracking never waits.
   int synchronous_young_map_keyframes = 20;
   // With a marker map: also every keyframe of a map not yet aligned to the marker world (its
-  // scale is anchored only once it is). Demo sequence, threaded, --ground-vehicle: world ATE
-  // 0.137-0.191 m in five runs instead of 0.37-2.32 m (map 2 aligned at scale 9.1 instead of
-  // 10-34), for 93-102 s of wall time instead of 40-45 s (BENCHMARKS.md).
+  // scale is anchored only once it is), at the cost of wall time (BENCHMARKS.md, "Threaded
+  // runs").
   bool synchronous_until_aligned = true;
   // The initialisation reference frame is replaced when the current frame is more than this
   // many seconds later (a reference is also replaced when too few matches are left). Long
@@ -84,10 +80,9 @@ struct SystemOptions {
   // aligned frames are optimised with the markers' corners. Unset: keypoints only.
   std::optional<MarkerMap> marker_map;
   // The detector's defaults, but without the edge refit of 20-60 px markers' corners
-  // (DetectorOptions::edge_refinement): its corners are the more accurate ones, yet in six
-  // blocking runs on simulated routes the SLAM with them was worse in four (the default
-  // world 0.100 -> 0.132-0.146 m world ATE, one 2 m board seed 0.038 -> 0.092-0.381 m) and
-  // better in two (BENCHMARKS.md, "Marker corners refitted from their edges").
+  // (DetectorOptions::edge_refinement): its corners are the more accurate ones, yet the SLAM
+  // with them was worse on most simulated routes (BENCHMARKS.md, "Marker corners refitted
+  // from their edges").
   DetectorOptions detector = [] {
     DetectorOptions options;
     options.edge_refinement = false;
@@ -101,15 +96,14 @@ struct SystemOptions {
   // whole image.
   MarkerSearchOptions marker_search;
   CameraLocatorOptions locator;
-  // Anchor outliers beyond 0.25 m: a single marker's pose at a few metres is off by 5-10 cm
-  // in rendered sequences (measured), more than WorldAlignmentOptions' 0.10 m default allows.
+  // Anchor outliers beyond 0.25 m: a single marker's pose at a few metres can be off by more
+  // than WorldAlignmentOptions' 0.10 m default allows.
   WorldAlignmentOptions alignment{0.0, 0.25, 0.05};
   // A marker location is used only when it is not ambiguous (several markers, or one whose
   // IPPE solutions are well separated) and its corner RMS is at most this, pixels.
   double max_marker_rms_px = 2.0;
   // ... and when its nearest marker is at most this many marker sides from the camera: a
-  // location's error grows with the square of the distance (default factory, 0.2 m markers:
-  // 1-2 cm at 2.5-4.5 m, 5-15 cm at 5-6 m with two markers, decimetres beyond).
+  // location's error grows with the square of the distance.
   double max_marker_distance_sides = 25.0;
   // An ambiguous one-marker location is still used when a prediction of the frame's world
   // pose (the aligned tracker's motion model, else constant velocity from the recent marker
@@ -132,8 +126,7 @@ struct SystemOptions {
   double max_alignment_rms_m = 0.15;
   // A map starts with its median point depth 1: aligning it multiplies lengths by about the
   // scene's depth in metres. A first alignment's scale above this means the map collapsed
-  // in scale before it saw markers (measured: 1256 for a map born in a bland U-turn, whose
-  // early poses then lay up to 224 m off); it is refused.
+  // in scale before it saw markers; it is refused.
   double max_alignment_scale = 100.0;
   // After the first alignment, anchors keep being collected and the map is aligned again
   // (a small Sim3 correction) each time their number doubles, up to this many anchors.
@@ -170,10 +163,8 @@ struct SystemOptions {
   bool map_unknown_markers = true;
   // A world-aligned map gets one bundle adjustment of all its keyframes and points with every
   // marker-corner observation (known markers fixed, mapped ones estimated, views of culled
-  // keyframes kept) when it is closed after a loss and at Finish. On the demo sequence this
-  // halves the monocular scale error (1.9% -> 0.9%) and cuts the world ATE from 0.40 to
-  // 0.24 m, for about 1 s of solving (corner weights: MarkerMapperOptions). false: at Finish
-  // only the mapped markers are refined.
+  // keyframes kept) when it is closed after a loss and at Finish (corner weights:
+  // MarkerMapperOptions). false: at Finish only the mapped markers are refined.
   bool whole_map_marker_adjustment = true;
   // A world-aligned map closed after a loss is kept whole and merged into the next map as
   // soon as that one is in the world too (one map again: relocalisation and loops reach the
@@ -191,8 +182,7 @@ struct SystemOptions {
   bool marker_drift_correction = true;
   // A loop closed in the world-aligned map is corrected with the same marker priors and
   // graph weights (marker_correction_graph), no keyframe held fixed: the loop then keeps the
-  // world anchoring. High-texture route with markers, before the end-of-run adjustment:
-  // world ATE 0.461 m without, 0.058 m with them.
+  // world anchoring.
   bool marker_priors_in_loops = true;
   double min_marker_correction_m = 0.05;
   double marker_correction_sigmas = 3.0;
@@ -212,8 +202,8 @@ struct SystemOptions {
     graph.edge_rotation_sigma = 0.005;
     graph.edge_scale_sigma = 0.01;
     // A drift of metres (a map whose scale collapsed out of the markers' sight) needs more
-    // than the solver's default 20 iterations (measured: 23 for 19 m); unconverged, the
-    // graph leaves the points torn apart (local BA from 63 px RMS).
+    // than the solver's default 20 iterations; unconverged, the graph leaves the points torn
+    // apart.
     graph.solver.max_iterations = 100;
     return graph;
   }();
@@ -227,9 +217,7 @@ struct SystemOptions {
   // constraints. Standard deviations: bridge_position_sigma_m + bridge_position_sigma_per_s
   // * gap (metres), and the same for rotation (radians; a turn in the gap is not predicted).
   // 0.1 m per second: a robot at 0.7 m/s turning at 0.4 rad/s it did not before strays
-  // 0.14 m from the straight line in a second. Demo sequence, blocking, --ground-vehicle (a
-  // 1.07 s gap at the east end's turn, prediction 0.16 m off): world ATE 0.1085 m without
-  // the bridge, 0.0921 m with it, before bridge_in_bundle_adjustment (BENCHMARKS.md).
+  // 0.14 m from the straight line in a second.
   bool bridge_tracking_gaps = true;
   WorldMotionPriorOptions bridge_motion{.max_age_s = 3.0, .min_span_s = 0.3, .max_span_s = 1.0};
   double bridge_position_sigma_m = 0.025;
@@ -240,9 +228,8 @@ struct SystemOptions {
   // in every bundle adjustment of the whole map (global BA after a loop, the whole-map
   // adjustment with markers), so that these no longer forget it. Its sigma there is
   // bridge_position_sigma_m + bridge_max_acceleration_m_s2 * gap^2 / 2: how far a vehicle
-  // can stray from the prediction. With the pose graph's tighter sigma, 5 seeds of the
-  // default world gained 20% on average but a right map was pulled 2 cm by a prediction
-  // 0.45 m off (system_recovery_test); BENCHMARKS.md, "Five seeds of the default world".
+  // can stray from the prediction (the pose graph's tighter sigma pulled a right map towards
+  // a wrong prediction: system_recovery_test).
   bool bridge_in_bundle_adjustment = true;
   double bridge_max_acceleration_m_s2 = 0.3;
 
@@ -270,14 +257,12 @@ struct SystemOptions {
   // reference keyframe: that offset was fixed before the map's later corrections. The new
   // pose is kept when at least refine_min_inlier_fraction of those matches (and at least the
   // tracker's min_pose_inliers) are still in the map and stay inliers.
-  // Costs about 7 kB per frame until Finish (demo sequence: peak memory 190 -> 202 MB over
-  // 1798 frames). false: frames keep their keyframe offsets.
+  // Keeps each tracked frame's matches until Finish. false: frames keep their keyframe
+  // offsets.
   bool refine_frame_poses = true;
   double refine_min_inlier_fraction = 0.5;
   // Trajectory leaves out the frames that lie far off the path between the keyframes around
-  // them in time (pose_consistency.h). Demo sequence, blocking, --ground-vehicle: 32 frames
-  // at 26.9-28.3 s and 29.8 s (0.66 m RMS off the truth), world ATE 0.139 -> 0.1085 m.
-  // false: every tracked pose is output.
+  // them in time (pose_consistency.h). false: every tracked pose is output.
   bool drop_inconsistent_poses = true;
   PoseConsistencyOptions pose_consistency;
 

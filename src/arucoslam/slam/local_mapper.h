@@ -26,11 +26,10 @@ struct LocalMapperOptions {
   double min_epipole_distance_px = 10.0;
   // Rays must make an angle with cosine below this (0.99999: about 0.26 degrees). A test on
   // the measured parallax keeps, among matches near the threshold, those whose noise widened
-  // the angle, so their points lie too near and the map shrinks. With 0.9998 (1.15 degrees)
-  // and first-passing pairing, the high-texture route without markers or loop closing had a
-  // Sim3 ATE of 2.4-3.0% of the distance over three noise seeds; with 0.99999 and the
-  // widest-parallax pairing (TriangulateNewPoints), 1.7-2.1%. Bundle adjustment refines
-  // the low-parallax points as more keyframes see them.
+  // the angle, so their points lie too near and the map shrinks; the widest-parallax pairing
+  // (TriangulateNewPoints) and a low floor shrink it least on the simulated routes
+  // (BENCHMARKS.md, "Keypoint-only scale drift"). Bundle adjustment refines the
+  // low-parallax points as more keyframes see them.
   double max_parallax_cos = 0.99999;
   // Reprojection test per view: squared error below chi2(2 dof, 95%) x sigma^2.
   double reprojection_chi2 = 5.991;
@@ -47,14 +46,12 @@ struct LocalMapperOptions {
   double min_found_ratio = 0.25;
   int min_point_observations = 3;
   bool run_bundle_adjustment = true;
-  // Local BA with two fixed keyframes: they hold the monocular scale. With one, the scale
-  // shrank 12-fold within 7 s of the simulator's forward motion (ATE 0.17 m vs 0.014 m).
+  // Local BA with two fixed keyframes: they hold the monocular scale (one leaves it free).
   LocalBundleAdjustmentOptions bundle_adjustment = [] {
     LocalBundleAdjustmentOptions options;
     options.min_fixed_keyframes = 2;
-    // A BA asked to yield (SetYieldRequest) still takes 5 iterations. Stopping after one left
-    // the threaded map at 6-10 px RMS and frames up to 9 m off (0.81 m world ATE on the 2 m
-    // wall-marker world; with 5: 0.029-0.049 m).
+    // A BA asked to yield (SetYieldRequest) still takes 5 iterations: stopping after one
+    // left the threaded map too far from converged (BENCHMARKS.md, "Threaded runs").
     options.solver.min_iterations_before_stop = 5;
     return options;
   }();
