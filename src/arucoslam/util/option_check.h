@@ -54,8 +54,8 @@ class OptionCheck {
   }
 
   // lo < or <= value < or <= hi, as `interval` says.
-  template <class T, class U>
-  OptionCheck& InRange(std::string_view field, const T& value, const U& lo, const U& hi,
+  template <class T, class L, class H>
+  OptionCheck& InRange(std::string_view field, const T& value, const L& lo, const H& hi,
                        Interval interval) {
     if (!ok_) return *this;
     const bool lo_closed = interval == Interval::kClosed || interval == Interval::kClosedOpen;
