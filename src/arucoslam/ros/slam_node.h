@@ -4,20 +4,19 @@
 // ~status, ~map_points and ~markers. Parameters: see SlamNodeParameters and the launch file.
 #pragma once
 
-#include <image_transport/image_transport.h>
-#include <nav_msgs/Path.h>
-#include <ros/ros.h>
-#include <sensor_msgs/CameraInfo.h>
-#include <sensor_msgs/Image.h>
-#include <tf2_ros/transform_broadcaster.h>
-
 #include <condition_variable>
 #include <deque>
 #include <memory>
 #include <mutex>
+#include <nav_msgs/Path.h>
 #include <optional>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
 #include <string>
 #include <thread>
+#include <tf2_ros/transform_broadcaster.h>
+#include <image_transport/image_transport.h>
 
 #include "arucoslam/ros/slam_session.h"
 #include "arucoslam/util/option_check.h"
