@@ -34,8 +34,10 @@ std::string AlignmentModeName(AlignmentMode mode) {
 bool AlignmentOptions::Check(std::string* why) const {
   OptionCheck check(why);
   check.AtLeast("first_poses", first_poses, 0);
-  if (window_start && window_end)
-    check.AtLeast("window_end", *window_end, *window_start, "window_start");
+  if (window_start && window_end) {
+    // Written as before (a NaN bound passes): only an end before the start is refused.
+    check.Rule(!(*window_end < *window_start), "window_end", *window_end, ">= window_start");
+  }
   return check.ok();
 }
 
