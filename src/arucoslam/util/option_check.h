@@ -82,14 +82,8 @@ class OptionCheck {
   template <class Options>
   OptionCheck& Nested(std::string_view field, const Options& options) {
     if (!ok_) return *this;
-    if constexpr (requires(std::string* s) { options.Check(s); }) {
-      std::string nested_why;
-      if (!options.Check(why_ != nullptr ? &nested_why : nullptr)) {
-        FailNested(field, nested_why);
-      }
-    } else if (!options.Check()) {
-      FailNested(field, "");
-    }
+    std::string nested_why;
+    if (!options.Check(why_ != nullptr ? &nested_why : nullptr)) FailNested(field, nested_why);
     return *this;
   }
 

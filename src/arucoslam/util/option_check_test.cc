@@ -17,9 +17,9 @@ struct Inner {
   }
 };
 
-struct Legacy {  // an options struct whose Check gives no reason
+struct Legacy {  // an options struct whose Check fails without writing a reason
   bool valid = true;
-  bool Check() const { return valid; }
+  bool Check(std::string* /*why*/ = nullptr) const { return valid; }
 };
 
 struct Outer {
