@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "arucoslam/geometry/umeyama.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -30,10 +31,14 @@ std::string AlignmentModeName(AlignmentMode mode) {
   return "none";
 }
 
-bool AlignmentOptions::Check() const {
-  if (first_poses < 0) return false;
-  if (window_start && window_end && *window_end < *window_start) return false;
-  return true;
+bool AlignmentOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.AtLeast("first_poses", first_poses, 0);
+  if (window_start && window_end) {
+    // Written as before (a NaN bound passes): only an end before the start is refused.
+    check.Rule(!(*window_end < *window_start), "window_end", *window_end, ">= window_start");
+  }
+  return check.ok();
 }
 
 std::optional<AlignmentResult> ComputeAlignment(const AssociatedTrajectories& pairs,

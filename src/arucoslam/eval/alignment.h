@@ -24,7 +24,7 @@ struct AlignmentOptions {
   std::optional<double> window_start;
   std::optional<double> window_end;
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 struct AlignmentResult {

@@ -2,16 +2,22 @@
 // the shorter trajectory is paired with the closest stamp of the longer one within max_diff.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "arucoslam/io/trajectory_io.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
 struct AssociationOptions {
   double max_time_difference = 0.01;  // seconds; a pair is kept when |t_gt - t_est| <= this
 
-  bool Check() const { return max_time_difference >= 0.0; }
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.AtLeast("max_time_difference", max_time_difference, 0.0);
+    return check.ok();
+  }
 };
 
 // Pose pairs in the order of the shorter trajectory: gt.poses[i] <-> est.poses[i].

@@ -2,7 +2,10 @@
 // poses, and its longest gap (before the first pose, between poses, after the last).
 #pragma once
 
+#include <string>
+
 #include "arucoslam/io/trajectory_io.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -11,7 +14,11 @@ struct CompletenessOptions {
   // 0 = automatic: 3 times the estimate's median frame interval.
   double max_gap = 0.0;
 
-  bool Check() const { return max_gap >= 0.0; }
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.AtLeast("max_gap", max_gap, 0.0);
+    return check.ok();
+  }
 };
 
 struct Completeness {

@@ -6,18 +6,21 @@
 #include <stdexcept>
 
 #include "arucoslam/util/error.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
-bool EvaluationOptions::Check() const {
-  if (!association.Check() || !alignment.Check() || !per_axis.Check() || !completeness.Check() ||
-      (scale_drift && !scale_drift->Check())) {
-    return false;
+bool EvaluationOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.Nested("association", association);
+  check.Nested("alignment", alignment);
+  check.Nested("per_axis", per_axis);
+  check.Nested("completeness", completeness);
+  if (scale_drift) check.Nested("scale_drift", *scale_drift);
+  for (std::size_t i = 0; i < relative.size(); ++i) {
+    check.Nested(fmt::format("relative[{}]", i), relative[i]);
   }
-  for (const RelativeErrorOptions& r : relative) {
-    if (!r.Check()) return false;
-  }
-  return true;
+  return check.ok();
 }
 
 namespace {

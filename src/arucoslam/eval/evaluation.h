@@ -29,7 +29,7 @@ struct EvaluationOptions {
   // Set: the Sim(3) scale over consecutive windows of this many seconds (scale_drift.h).
   std::optional<ScaleDriftOptions> scale_drift;
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 struct RelativeErrorResult {

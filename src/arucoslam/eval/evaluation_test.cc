@@ -102,3 +102,23 @@ TEST(Evaluation, BadInputIsAnInputError) {
 
 }  // namespace
 }  // namespace arucoslam
+
+namespace arucoslam {
+namespace {
+
+TEST(Evaluation, OptionsCheckSaysWhichValueIsWrong) {
+  EvaluationOptions options;
+  std::string why;
+  EXPECT_TRUE(options.Check(&why)) << why;
+  options.relative.push_back(RelativeErrorOptions{});
+  options.relative[1].relative_tolerance = -0.5;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_EQ(why, "relative[1].relative_tolerance must be >= 0, is -0.5");
+  options = {};
+  options.association.max_time_difference = -1.0;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_EQ(why, "association.max_time_difference must be >= 0, is -1");
+}
+
+}  // namespace
+}  // namespace arucoslam

@@ -3,9 +3,11 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <string>
 #include <vector>
 
 #include "arucoslam/geometry/sim3.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -35,7 +37,11 @@ double DistanceToNearestSurface(const std::vector<SurfacePrimitive>& primitives,
 struct MapAccuracyOptions {
   double inlier_distance = 0.05;  // m, "within" threshold for fraction_within
 
-  bool Check() const { return inlier_distance > 0.0; }
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.Above("inlier_distance", inlier_distance, 0.0);
+    return check.ok();
+  }
 };
 
 struct MapAccuracy {

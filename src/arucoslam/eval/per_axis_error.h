@@ -3,9 +3,11 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <string>
 #include <vector>
 
 #include "arucoslam/io/trajectory_io.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -15,7 +17,11 @@ struct PerAxisErrorOptions {
   std::vector<double> timestamps;
   double max_time_difference = 0.1;  // seconds
 
-  bool Check() const { return max_time_difference >= 0.0; }
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.AtLeast("max_time_difference", max_time_difference, 0.0);
+    return check.ok();
+  }
 };
 
 struct PerAxisSample {

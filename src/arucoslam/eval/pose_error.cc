@@ -5,6 +5,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "arucoslam/util/option_check.h"
+
 namespace arucoslam {
 namespace {
 
@@ -97,10 +99,13 @@ std::string DeltaUnitName(DeltaUnit unit) {
   return "";
 }
 
-bool RelativeErrorOptions::Check() const {
-  if (!(delta > 0.0) || !std::isfinite(delta)) return false;
-  if (unit == DeltaUnit::kFrames && delta != std::floor(delta)) return false;
-  return relative_tolerance >= 0.0;
+bool RelativeErrorOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.Rule(delta > 0.0 && std::isfinite(delta), "delta", delta, "finite and > 0");
+  check.Rule(unit != DeltaUnit::kFrames || delta == std::floor(delta), "delta", delta,
+             "a whole number of frames");
+  check.AtLeast("relative_tolerance", relative_tolerance, 0.0);
+  return check.ok();
 }
 
 std::vector<double> AbsolutePoseErrors(const Trajectory& gt, const Trajectory& est,

@@ -34,7 +34,7 @@ struct RelativeErrorOptions {
   double relative_tolerance = 0.1;  // all_pairs with metres/seconds: accept |d - delta| <=
                                     // tolerance * delta
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 using IndexPairs = std::vector<std::pair<std::size_t, std::size_t>>;

@@ -3,9 +3,11 @@
 #pragma once
 
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "arucoslam/eval/association.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -16,7 +18,13 @@ struct ScaleDriftOptions {
   double min_extent_m = 0.3;
   int min_pairs = 4;  // pose pairs a window needs
 
-  bool Check() const { return window_s > 0.0 && min_extent_m >= 0.0 && min_pairs >= 3; }
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.Above("window_s", window_s, 0.0);
+    check.AtLeast("min_extent_m", min_extent_m, 0.0);
+    check.AtLeast("min_pairs", min_pairs, 3);
+    return check.ok();
+  }
 };
 
 struct ScaleDriftWindow {

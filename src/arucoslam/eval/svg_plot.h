@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "arucoslam/util/option_check.h"
+
 namespace arucoslam {
 
 class SvgPlot {
@@ -18,7 +20,12 @@ class SvgPlot {
     bool equal_aspect = false;  // same metres per pixel on both axes (top-down views)
     bool y_from_zero = false;   // include 0 in the y range (error plots)
 
-    bool Check() const { return width >= 200 && height >= 150; }
+    bool Check(std::string* why = nullptr) const {
+      OptionCheck check(why);
+      check.AtLeast("width", width, 200);
+      check.AtLeast("height", height, 150);
+      return check.ok();
+    }
   };
 
   explicit SvgPlot(Options options);

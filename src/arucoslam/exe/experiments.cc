@@ -172,7 +172,9 @@ ExperimentRun KeypointSlamRun(const std::string& label, const std::string& seque
 }  // namespace
 
 ExperimentsResult RunExperiments(const ExperimentsOptions& options) {
-  if (!options.Check()) throw InputError("experiments", "invalid options");
+  if (std::string why; !options.Check(&why)) {
+    throw InputError("experiments", "invalid options: " + why);
+  }
   RequireDirectory(options.world_dir, "world folder");
   const std::vector<TimedPose> poses = RepeatRunPoses(options.world_dir, options.max_seconds);
   // Loaded before anything is rendered: a bad vocabulary fails fast.

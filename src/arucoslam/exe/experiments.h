@@ -11,6 +11,7 @@
 #include "arucoslam/eval/evaluation.h"
 #include "arucoslam/eval/map_accuracy.h"
 #include "arucoslam/sim/dataset_writer.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -31,7 +32,12 @@ struct ExperimentsOptions {
   // near one camera height and tilt in the whole-map adjustment (`run --ground-vehicle`).
   bool ground_vehicle = true;
 
-  bool Check() const { return max_seconds >= 0.0 && render.Check(); }
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.AtLeast("max_seconds", max_seconds, 0.0);
+    check.Nested("render", render);
+    return check.ok();
+  }
 };
 
 // One method's result on one sequence.

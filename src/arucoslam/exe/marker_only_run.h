@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <string>
 
 #include "arucoslam/io/dataset_reader.h"
 #include "arucoslam/io/trajectory_io.h"
@@ -11,6 +12,7 @@
 #include "arucoslam/markers/detector.h"
 #include "arucoslam/markers/marker_map.h"
 #include "arucoslam/markers/preprocess.h"
+#include "arucoslam/util/option_check.h"
 #include "arucoslam/util/timing.h"
 
 namespace arucoslam {
@@ -23,7 +25,12 @@ struct MarkerOnlyOptions {
   bool skip_ambiguous = true;
   bool progress = true;  // a progress line on stderr
 
-  bool Check() const { return preprocess.Check() && locator.Check(); }
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.Nested("preprocess", preprocess);
+    check.Nested("locator", locator);
+    return check.ok();
+  }
 };
 
 struct MarkerOnlyResult {

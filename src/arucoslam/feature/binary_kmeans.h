@@ -6,9 +6,11 @@
 #include <cstdint>
 #include <cstring>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "arucoslam/feature/keypoints.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -45,7 +47,12 @@ BinaryDescriptor MajorityDescriptor(const std::vector<BinaryDescriptor>& descrip
 struct KMajorityOptions {
   int k = 10;               // clusters wanted (fewer when there are fewer distinct descriptors)
   int max_iterations = 10;  // assignment/update rounds after seeding; stops earlier when stable
-  bool Check() const { return k >= 2 && max_iterations >= 1; }
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.AtLeast("k", k, 2);
+    check.AtLeast("max_iterations", max_iterations, 1);
+    return check.ok();
+  }
 };
 
 struct KMajorityResult {

@@ -2,13 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 #include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
-#include <mutex>
 #include <stdexcept>
 
 #include "arucoslam/feature/quadtree_spread.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 namespace {
@@ -238,11 +239,20 @@ void Describe(const cv::Mat& blurred, const cv::KeyPoint& kp, const PatternColum
 
 }  // namespace
 
-bool OrbExtractorOptions::Check() const {
-  return num_features > 0 && num_levels >= 1 && num_levels <= 32 && scale_factor > 1.0 &&
-         initial_fast_threshold > 0 && min_fast_threshold > 0 &&
-         min_fast_threshold <= initial_fast_threshold && cell_size_px >= 8 &&
-         edge_margin_px >= kOrientationPatchRadius + 1 && num_threads >= 1 && num_threads <= 64;
+bool OrbExtractorOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.Above("num_features", num_features, 0);
+  check.InRange("num_levels", num_levels, 1, 32, Interval::kClosed);
+  check.Above("scale_factor", scale_factor, 1.0);
+  check.Above("initial_fast_threshold", initial_fast_threshold, 0);
+  check.Above("min_fast_threshold", min_fast_threshold, 0);
+  check.AtMost("min_fast_threshold", min_fast_threshold, initial_fast_threshold,
+               "initial_fast_threshold");
+  check.AtLeast("cell_size_px", cell_size_px, 8);
+  check.AtLeast("edge_margin_px", edge_margin_px, kOrientationPatchRadius + 1,
+                "kOrientationPatchRadius + 1");
+  check.InRange("num_threads", num_threads, 1, 64, Interval::kClosed);
+  return check.ok();
 }
 
 OrbExtractor::OrbExtractor(const OrbExtractorOptions& options)

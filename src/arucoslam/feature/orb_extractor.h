@@ -4,6 +4,7 @@
 
 #include <memory>
 #include <opencv2/core.hpp>
+#include <string>
 #include <vector>
 
 #include "arucoslam/feature/brief_pattern.h"
@@ -25,7 +26,7 @@ struct OrbExtractorOptions {
   // faster alone on two cores but slower in a `run` sharing them (BENCHMARKS.md).
   int num_threads = 1;
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 class OrbExtractor {

@@ -52,6 +52,9 @@ TEST(OrbExtractorOptions, CheckRejectsBadValues) {
   options = {};
   options.min_fast_threshold = 30;  // above the initial threshold
   EXPECT_FALSE(options.Check());
+  std::string why;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_EQ(why, "min_fast_threshold must be <= initial_fast_threshold (20), is 30");
   options = {};
   options.edge_margin_px = 10;  // smaller than the orientation patch
   EXPECT_FALSE(options.Check());

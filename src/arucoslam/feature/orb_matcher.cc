@@ -6,6 +6,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "arucoslam/util/option_check.h"
+
 namespace arucoslam {
 namespace {
 
@@ -72,9 +74,12 @@ int HammingDistance(const std::uint8_t* a, const std::uint8_t* b) {
   return bits;
 }
 
-bool RotationCheckOptions::Check() const {
-  return histogram_bins >= 1 && keep_bins >= 1 && min_fraction_of_best >= 0.0 &&
-         min_fraction_of_best <= 1.0;
+bool RotationCheckOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.AtLeast("histogram_bins", histogram_bins, 1);
+  check.AtLeast("keep_bins", keep_bins, 1);
+  check.InRange("min_fraction_of_best", min_fraction_of_best, 0.0, 1.0, Interval::kClosed);
+  return check.ok();
 }
 
 std::vector<FeatureMatch> FilterByRotationConsistency(const std::vector<FeatureMatch>& matches,
@@ -108,8 +113,12 @@ std::vector<FeatureMatch> FilterByRotationConsistency(const std::vector<FeatureM
   return kept;
 }
 
-bool BruteForceMatchOptions::Check() const {
-  return max_distance >= 0 && ratio > 0.0 && rotation.Check();
+bool BruteForceMatchOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.AtLeast("max_distance", max_distance, 0);
+  check.Above("ratio", ratio, 0.0);
+  check.Nested("rotation", rotation);
+  return check.ok();
 }
 
 std::vector<FeatureMatch> MatchBruteForce(const OrbFeatures& features1,
@@ -146,9 +155,14 @@ std::vector<FeatureMatch> MatchBruteForce(const OrbFeatures& features1,
   return matches;
 }
 
-bool WindowMatchOptions::Check() const {
-  return window_radius_px > 0.0 && max_level_difference >= 0 && max_distance >= 0 && ratio > 0.0 &&
-         rotation.Check();
+bool WindowMatchOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.Above("window_radius_px", window_radius_px, 0.0);
+  check.AtLeast("max_level_difference", max_level_difference, 0);
+  check.AtLeast("max_distance", max_distance, 0);
+  check.Above("ratio", ratio, 0.0);
+  check.Nested("rotation", rotation);
+  return check.ok();
 }
 
 std::vector<FeatureMatch> MatchInWindow(const OrbFeatures& features1, const OrbFeatures& features2,
@@ -180,9 +194,14 @@ std::vector<FeatureMatch> MatchInWindow(const OrbFeatures& features1, const OrbF
   return matches;
 }
 
-bool ProjectionMatchOptions::Check() const {
-  return base_radius_px > 0.0 && level_tolerance >= 0 && max_distance >= 0 && ratio > 0.0 &&
-         rotation.Check();
+bool ProjectionMatchOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.Above("base_radius_px", base_radius_px, 0.0);
+  check.AtLeast("level_tolerance", level_tolerance, 0);
+  check.AtLeast("max_distance", max_distance, 0);
+  check.Above("ratio", ratio, 0.0);
+  check.Nested("rotation", rotation);
+  return check.ok();
 }
 
 std::vector<FeatureMatch> MatchByProjection(const OrbFeatures& features, const FeatureGrid& grid,

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "arucoslam/feature/feature_grid.h"
@@ -26,7 +27,7 @@ struct RotationCheckOptions {
   int keep_bins = 3;        // the most populated bins that are kept
   // A kept bin other than the fullest must hold at least this fraction of the fullest.
   double min_fraction_of_best = 0.1;
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 // Keeps the matches whose angle difference (angle2 - angle1) falls in the dominant bins.
@@ -42,7 +43,7 @@ struct BruteForceMatchOptions {
   bool cross_check = true;     // keep only mutual best matches
   bool check_rotation = true;  // apply FilterByRotationConsistency
   RotationCheckOptions rotation;
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 std::vector<FeatureMatch> MatchBruteForce(const OrbFeatures& features1,
@@ -56,7 +57,7 @@ struct WindowMatchOptions {
   double ratio = 0.9;               // best < ratio * second best
   bool check_rotation = true;
   RotationCheckOptions rotation;
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 // Matching for initialisation: feature i of `features1` is searched for in `features2` within
@@ -84,7 +85,7 @@ struct ProjectionMatchOptions {
   double ratio = 0.8;           // best < ratio * second best when both are at the same level
   bool check_rotation = false;  // needs every query's angle >= 0
   RotationCheckOptions rotation;
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 // Returns matches with index1 = query index and index2 = feature index; each feature is used

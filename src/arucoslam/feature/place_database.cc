@@ -4,10 +4,16 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "arucoslam/util/option_check.h"
+
 namespace arucoslam {
 
-bool PlaceQueryOptions::Check() const {
-  return max_results >= 1 && min_score >= 0.0 && min_score <= 1.0 && min_shared_words >= 1;
+bool PlaceQueryOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.AtLeast("max_results", max_results, 1);
+  check.InRange("min_score", min_score, 0.0, 1.0, Interval::kClosed);
+  check.AtLeast("min_shared_words", min_shared_words, 1);
+  return check.ok();
 }
 
 PlaceDatabase::PlaceDatabase(std::size_t num_words) : inverted_(num_words) {}

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -21,7 +22,7 @@ struct PlaceQueryOptions {
   int max_results = 10;      // at most this many matches, best first (>= 1)
   double min_score = 0.0;    // matches scoring below this are dropped ([0, 1])
   int min_shared_words = 1;  // matches sharing fewer words are dropped (>= 1)
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 // Entries are identified by a 64-bit id (a keyframe id's value; see TypedPlaceDatabase). Not

@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "arucoslam/util/option_check.h"
+
 namespace arucoslam {
 namespace {
 
@@ -19,8 +21,12 @@ void CheckDescriptorMatrix(const cv::Mat& descriptors) {
 
 }  // namespace
 
-bool VocabularyOptions::Check() const {
-  return branching >= 2 && branching <= 255 && levels >= 1 && levels <= 8 && max_iterations >= 1;
+bool VocabularyOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.InRange("branching", branching, 2, 255, Interval::kClosed);
+  check.InRange("levels", levels, 1, 8, Interval::kClosed);
+  check.AtLeast("max_iterations", max_iterations, 1);
+  return check.ok();
 }
 
 Vocabulary Vocabulary::Train(const std::vector<cv::Mat>& descriptors_per_image,

@@ -18,7 +18,7 @@ struct VocabularyOptions {
   int levels = 5;           // L: depth of the leaves below the root (1..8); k^L words at most
   int max_iterations = 10;  // k-majority rounds per node
   std::uint64_t seed = 1;   // seed of the k-means++ choices (training is deterministic)
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 class Vocabulary {

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "arucoslam/util/option_check.h"
+
 namespace arucoslam {
 namespace {
 
@@ -173,26 +175,30 @@ int NumDistortionCoefficients(DistortionModel model) {
   return 0;
 }
 
-bool CameraModel::Check() const {
-  if (width <= 0 || height <= 0) return false;
-  if (!(fx > 0.0) || !(fy > 0.0) || !std::isfinite(fx) || !std::isfinite(fy)) return false;
-  if (!std::isfinite(cx) || !std::isfinite(cy)) return false;
-  if (!std::isfinite(rate_hz) || rate_hz < 0.0) return false;
+bool CameraModel::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.Above("width", width, 0);
+  check.Above("height", height, 0);
+  check.Rule(fx > 0.0 && std::isfinite(fx), "fx", fx, "finite and > 0");
+  check.Rule(fy > 0.0 && std::isfinite(fy), "fy", fy, "finite and > 0");
+  check.Rule(std::isfinite(cx), "cx", cx, "finite");
+  check.Rule(std::isfinite(cy), "cy", cy, "finite");
+  check.Rule(std::isfinite(rate_hz) && rate_hz >= 0.0, "rate_hz", rate_hz, "finite and >= 0");
   for (const double coefficient : distortion) {
-    if (!std::isfinite(coefficient)) return false;
+    check.Rule(std::isfinite(coefficient), "distortion", coefficient, "finite");
   }
   const int used = NumDistortionCoefficients(model);
   for (int i = used; i < kMaxDistortionCoefficients; ++i) {
-    if (distortion[i] != 0.0) return false;
+    check.Rule(distortion[i] == 0.0, "distortion", distortion[i],
+               "0 beyond the model's coefficients");
   }
   // A tilt of 90 degrees or more folds the sensor plane onto itself.
   if (model == DistortionModel::kTilted) {
     constexpr double kMaxTilt = 0.5 * std::numbers::pi;
-    if (!(std::abs(distortion[12]) < kMaxTilt) || !(std::abs(distortion[13]) < kMaxTilt)) {
-      return false;
-    }
+    check.Below("tilt tau_x", std::abs(distortion[12]), kMaxTilt, "pi/2 in magnitude");
+    check.Below("tilt tau_y", std::abs(distortion[13]), kMaxTilt, "pi/2 in magnitude");
   }
-  return true;
+  return check.ok();
 }
 
 std::vector<double> CameraModel::DistortionCoefficients() const {

@@ -37,7 +37,7 @@ struct CameraModel {
   double rate_hz = 0.0;                                         // frame rate where known, else 0
 
   // Positive size and focal lengths, finite values, zero beyond the model's coefficients.
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 
   // The model's coefficients, as OpenCV's functions take them (empty for kNone; cv::fisheye
   // for kEquidistant, cv::projectPoints and cv::undistort for the others).

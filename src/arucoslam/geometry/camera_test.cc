@@ -272,6 +272,9 @@ TEST(CameraModelTest, CheckRejectsInvalidParameters) {
   camera = EurocRadTan();
   camera.height = 0;
   EXPECT_FALSE(camera.Check());
+  std::string why;
+  EXPECT_FALSE(camera.Check(&why));
+  EXPECT_EQ(why, "height must be > 0, is 0");
   camera = EurocRadTan();
   camera.cy = std::nan("");
   EXPECT_FALSE(camera.Check());

@@ -2,9 +2,11 @@
 // position lies far from the path between its two neighbouring keyframes is left out.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "arucoslam/geometry/rigid3.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -23,7 +25,12 @@ struct PoseConsistencyOptions {
   double max_offset_m = 0.25;
   double max_keyframe_gap_s = 1.0;
 
-  bool Check() const { return max_offset_m > 0.0 && max_keyframe_gap_s > 0.0; }
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.Above("max_offset_m", max_offset_m, 0.0);
+    check.Above("max_keyframe_gap_s", max_keyframe_gap_s, 0.0);
+    return check.ok();
+  }
 };
 
 // The frames (in time order) that agree with `keyframes` (any order, same world frame).

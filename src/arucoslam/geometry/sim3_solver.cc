@@ -8,6 +8,7 @@
 #include <random>
 
 #include "arucoslam/geometry/umeyama.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 namespace {
@@ -245,11 +246,18 @@ std::optional<Sim3> Ransac(const CameraModel& current_camera, const CameraModel&
 
 }  // namespace
 
-bool Sim3SolverOptions::Check() const {
-  return max_ransac_iterations > 0 && confidence > 0.0 && confidence < 1.0 &&
-         chi_square_threshold > 0.0 && min_inliers >= 3 && refine_iterations >= 0 &&
-         huber_delta > 0.0 && min_scale_baseline_ratio >= 0.0 && min_scale > 0.0 &&
-         max_scale >= min_scale;
+bool Sim3SolverOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.Above("max_ransac_iterations", max_ransac_iterations, 0);
+  check.InRange("confidence", confidence, 0.0, 1.0, Interval::kOpen);
+  check.Above("chi_square_threshold", chi_square_threshold, 0.0);
+  check.AtLeast("min_inliers", min_inliers, 3);
+  check.AtLeast("refine_iterations", refine_iterations, 0);
+  check.Above("huber_delta", huber_delta, 0.0);
+  check.AtLeast("min_scale_baseline_ratio", min_scale_baseline_ratio, 0.0);
+  check.Above("min_scale", min_scale, 0.0);
+  check.AtLeast("max_scale", max_scale, min_scale, "min_scale");
+  return check.ok();
 }
 
 Eigen::Vector2d Sim3ChiSquares(const CameraModel& current_camera,

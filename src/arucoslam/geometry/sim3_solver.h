@@ -48,7 +48,7 @@ struct Sim3SolverOptions {
   double max_scale = 10.0;
   std::uint32_t seed = 1;       // random sampling, deterministic for a seed
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 struct Sim3SolverResult {

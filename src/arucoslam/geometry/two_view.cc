@@ -8,6 +8,8 @@
 #include <cmath>
 #include <random>
 
+#include "arucoslam/util/option_check.h"
+
 namespace arucoslam {
 namespace {
 
@@ -209,7 +211,12 @@ double ScoreHomography(const Eigen::Matrix3d& homography, const Point2dList& poi
   return score;
 }
 
-bool TwoViewRansacOptions::Check() const { return iterations > 0 && sigma > 0.0; }
+bool TwoViewRansacOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.Above("iterations", iterations, 0);
+  check.Above("sigma", sigma, 0.0);
+  return check.ok();
+}
 
 TwoViewModel FindFundamentalRansac(const Point2dList& points1, const Point2dList& points2,
                                    const TwoViewRansacOptions& options) {

@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "arucoslam/geometry/rigid3.h"
@@ -39,7 +40,7 @@ struct TwoViewRansacOptions {
   double sigma = 1.0;           // measurement noise, units of the points (pixels)
   std::uint32_t seed = 0x5eed;  // random generator seed (same seed -> same result)
   bool refine = true;           // refit on all inliers and keep the refit if it scores higher
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 struct TwoViewModel {

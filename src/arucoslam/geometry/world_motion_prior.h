@@ -4,8 +4,10 @@
 
 #include <deque>
 #include <optional>
+#include <string>
 
 #include "arucoslam/geometry/rigid3.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -17,8 +19,12 @@ struct WorldMotionPriorOptions {
   double min_span_s = 0.1;
   double max_span_s = 1.0;
 
-  bool Check() const {
-    return max_age_s > 0.0 && min_span_s > 0.0 && max_span_s >= min_span_s;
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.Above("max_age_s", max_age_s, 0.0);
+    check.Above("min_span_s", min_span_s, 0.0);
+    check.AtLeast("max_span_s", max_span_s, min_span_s, "min_span_s");
+    return check.ok();
   }
 };
 

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "arucoslam/io/frame_source.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -25,7 +26,11 @@ struct CameraSourceOptions {
   // OpenCV capture backend: cv::CAP_V4L2 for devices, cv::CAP_ANY to let OpenCV choose.
   int api = cv::CAP_ANY;
 
-  bool Check() const { return queue_capacity >= 1; }
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.AtLeast("queue_capacity", queue_capacity, 1);
+    return check.ok();
+  }
 };
 
 class CameraSource : public FrameSource {

@@ -269,9 +269,10 @@ class ConfigReader {
     std::vector<Change> changes_;
   };
 
-  // A section's Check() fails: names the value the file set that makes it fail.
+  // A section's Check() fails: names the value the file set that makes it fail, and the
+  // reason the check gave (`why`, a field path relative to the section).
   [[noreturn]] void FailCheck(const std::string& path, const YAML::Node& node,
-                              std::vector<Change>& changes,
+                              std::vector<Change>& changes, const std::string& why,
                               const std::function<bool()>& check) const;
 
   std::string source_;
@@ -307,15 +308,18 @@ void ConfigReader::ReadSection(const YAML::Node& node, const std::string& path, 
   }
   SectionVisitor fields(*this, path, entries);
   VisitOptions(options, fields);
-  if constexpr (requires { options.Check(); }) {
-    if (!options.Check()) FailCheck(path, node, fields.changes(), [&] { return options.Check(); });
+  if constexpr (requires(std::string * why) { options.Check(why); }) {
+    if (std::string why; !options.Check(&why)) {
+      FailCheck(path, node, fields.changes(), why, [&] { return options.Check(); });
+    }
   }
 }
 
 void ConfigReader::FailCheck(const std::string& path, const YAML::Node& node,
-                             std::vector<Change>& changes,
+                             std::vector<Change>& changes, const std::string& why,
                              const std::function<bool()>& check) const {
   const std::string section = path.empty() ? "top-level" : path;
+  const std::string reason = KeyPath(path, why);
   // The values whose previous value alone passes the check; else all the section's values.
   std::vector<const Change*> culprits;
   for (Change& change : changes) {
@@ -325,8 +329,8 @@ void ConfigReader::FailCheck(const std::string& path, const YAML::Node& node,
   }
   if (culprits.size() == 1) {
     Fail(culprits[0]->key_path, culprits[0]->mark,
-         fmt::format("{} is out of range or inconsistent with the other {} options",
-                     culprits[0]->text, section));
+         fmt::format("{} is out of range or inconsistent with the other {} options: {}",
+                     culprits[0]->text, section, reason));
   }
   if (culprits.empty()) {
     for (const Change& change : changes) culprits.push_back(&change);
@@ -338,9 +342,9 @@ void ConfigReader::FailCheck(const std::string& path, const YAML::Node& node,
   }
   const YAML::Mark mark = path.empty() ? YAML::Mark::null_mark() : node.Mark();
   Fail(path, mark,
-       values.empty()
-           ? fmt::format("the {} options fail their check", section)
-           : fmt::format("these values fail the {} options' check together: {}", section, values));
+       values.empty() ? fmt::format("the {} options fail their check: {}", section, reason)
+                      : fmt::format("these values fail the {} options' check together: {}; {}",
+                                    section, values, reason));
 }
 
 }  // namespace

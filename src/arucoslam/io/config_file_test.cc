@@ -140,12 +140,15 @@ TEST(ConfigFileTest, BadFilesNameTheKeyAndLine) {
        "extractor.num_levels (line 3): duplicate key"},
       {"extractor:\n  num_features: 1500\n  num_levels: 0\n",
        "test.yaml: extractor.num_levels (line 3): 0 is out of range or inconsistent with the "
-       "other extractor options"},
+       "other extractor options: extractor.num_levels must be in [1, 32], is 0"},
       {"mapper:\n  bundle_adjustment:\n    solver:\n      max_iterations: -2\n",
-       "mapper.bundle_adjustment.solver.max_iterations (line 4): -2 is out of range"},
+       "mapper.bundle_adjustment.solver.max_iterations (line 4): -2 is out of range or "
+       "inconsistent with the other mapper.bundle_adjustment.solver options: "
+       "mapper.bundle_adjustment.solver.max_iterations must be >= 1, is -2"},
       {"min_alignment_anchors: 8\nmax_realignment_anchors: 6\n",
        "test.yaml: these values fail the top-level options' check together: "
-       "min_alignment_anchors: 8 (line 1), max_realignment_anchors: 6 (line 2)"},
+       "min_alignment_anchors: 8 (line 1), max_realignment_anchors: 6 (line 2); "
+       "max_realignment_anchors must be >= min_alignment_anchors (8), is 6"},
   };
   for (const auto& [text, expected] : cases) {
     const std::string message = ParseError(text);

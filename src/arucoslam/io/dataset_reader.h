@@ -14,6 +14,7 @@
 #include "arucoslam/geometry/camera.h"
 #include "arucoslam/geometry/rigid3.h"
 #include "arucoslam/io/trajectory_io.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -42,7 +43,11 @@ struct DatasetOptions {
   // to use as ground truth instead of SEQ/../../poses/<SEQ name>.txt. Empty: that one if present.
   std::filesystem::path ground_truth_path;
 
-  bool Check() const { return rate_hz >= 0.0; }
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.AtLeast("rate_hz", rate_hz, 0.0);
+    return check.ok();
+  }
 };
 
 struct DatasetFrame {

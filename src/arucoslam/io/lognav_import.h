@@ -7,6 +7,7 @@
 
 #include "arucoslam/geometry/rigid3.h"
 #include "arucoslam/markers/marker_map.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -14,7 +15,11 @@ struct LognavImportOptions {
   std::string dictionary = "DICT_4X4_50";  // the list does not say; its users detect 4x4_50
   bool fixed = true;                       // value of MarkerInfo::fixed for every marker
 
-  bool Check() const { return !dictionary.empty(); }
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.Require(!dictionary.empty(), "dictionary", "non-empty");
+    return check.ok();
+  }
 };
 
 // world_from_marker of a LOGNAV entry. Their Gazebo model is a box thin along its own x

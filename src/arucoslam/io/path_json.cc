@@ -11,6 +11,7 @@
 
 #include "arucoslam/util/error.h"
 #include "arucoslam/util/files.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 namespace {
@@ -123,11 +124,13 @@ PathOptions ReadOptions(const Json& value, const std::string& source) {
 
 }  // namespace
 
-bool PathOptions::Check() const {
+bool PathOptions::Check(std::string* why) const {
+  OptionCheck check(why);
   for (const OptionField& field : OptionFields()) {
-    if (!InRange(field, this->*field.member)) return false;
+    check.Rule(InRange(field, this->*field.member), field.key, this->*field.member,
+               fmt::format("in {}", RangeText(field)));
   }
-  return true;
+  return check.ok();
 }
 
 std::string PathSpecProblem(const PathSpec& spec) {

@@ -34,7 +34,7 @@ struct PathOptions {
   double repeat_deviation_wavelength_m = 7.0;  // repeat run: shortest wavelength, m (> 0)
   std::uint32_t seed = 1;                      // vibration and repeat deviation come from it
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 // The content of path.json. A route that ends where it starts is a loop.

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "arucoslam/io/frame_source.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -16,7 +17,11 @@ struct VideoSourceOptions {
   // Frame rate in Hz that gives the timestamps (index / rate); 0: the container's timestamps.
   double rate_hz = 0.0;
 
-  bool Check() const { return rate_hz >= 0.0; }
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.AtLeast("rate_hz", rate_hz, 0.0);
+    return check.ok();
+  }
 };
 
 class VideoSource : public FrameSource {

@@ -6,12 +6,19 @@
 #include <opencv2/calib3d.hpp>
 #include <set>
 
+#include "arucoslam/util/option_check.h"
+
 namespace arucoslam {
 
-bool CameraLocatorOptions::Check() const {
-  return inlier_threshold_px > 0.0 && ransac_iterations >= 1 && ransac_confidence > 0.0 &&
-         ransac_confidence < 1.0 && min_inlier_corners >= 4 && refine_max_iterations >= 0 &&
-         marker_pose.Check();
+bool CameraLocatorOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.Above("inlier_threshold_px", inlier_threshold_px, 0.0);
+  check.AtLeast("ransac_iterations", ransac_iterations, 1);
+  check.InRange("ransac_confidence", ransac_confidence, 0.0, 1.0, Interval::kOpen);
+  check.AtLeast("min_inlier_corners", min_inlier_corners, 4);
+  check.AtLeast("refine_max_iterations", refine_max_iterations, 0);
+  check.Nested("marker_pose", marker_pose);
+  return check.ok();
 }
 
 namespace {

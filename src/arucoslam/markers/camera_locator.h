@@ -11,6 +11,7 @@
 #include "arucoslam/markers/detector.h"
 #include "arucoslam/markers/marker_map.h"
 #include "arucoslam/markers/marker_pose.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -22,7 +23,7 @@ struct CameraLocatorOptions {
   int refine_max_iterations = 30;    // Levenberg-Marquardt iterations (0: no refinement)
   MarkerPoseOptions marker_pose;     // per-marker IPPE and its ambiguity test
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 struct LocateQuality {
@@ -55,8 +56,12 @@ struct AmbiguityPriorGates {
   double max_position_m = 0.2;
   double min_disagreement = 2.0;  // > 1
 
-  bool Check() const {
-    return max_rotation_deg > 0.0 && max_position_m > 0.0 && min_disagreement > 1.0;
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.Above("max_rotation_deg", max_rotation_deg, 0.0);
+    check.Above("max_position_m", max_position_m, 0.0);
+    check.Above("min_disagreement", min_disagreement, 1.0);
+    return check.ok();
   }
 };
 

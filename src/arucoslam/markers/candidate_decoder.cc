@@ -8,6 +8,7 @@
 
 #include "arucoslam/geometry/image_sampling.h"
 #include "arucoslam/markers/edge_refiner.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 namespace {
@@ -81,12 +82,20 @@ std::vector<double> SampleCells(const cv::Mat& gray, const std::array<cv::Point2
 
 }  // namespace
 
-bool CandidateDecoderOptions::Check() const {
-  return marker_border_bits >= 1 && samples_per_cell >= 1 && ignored_margin_per_cell >= 0.0 &&
-         ignored_margin_per_cell < 0.5 && min_contrast >= 0.0 && max_erroneous_border_bits >= 0 &&
-         error_correction_rate >= 0.0 && error_correction_rate <= 1.0 &&
-         refine_window_cells > 0.0 && max_refine_shift_cells > 0.0 && sharpening >= 0.0 &&
-         edges.Check();
+bool CandidateDecoderOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.AtLeast("marker_border_bits", marker_border_bits, 1);
+  check.AtLeast("samples_per_cell", samples_per_cell, 1);
+  check.InRange("ignored_margin_per_cell", ignored_margin_per_cell, 0.0, 0.5,
+                Interval::kClosedOpen);
+  check.AtLeast("min_contrast", min_contrast, 0.0);
+  check.AtLeast("max_erroneous_border_bits", max_erroneous_border_bits, 0);
+  check.InRange("error_correction_rate", error_correction_rate, 0.0, 1.0, Interval::kClosed);
+  check.Above("refine_window_cells", refine_window_cells, 0.0);
+  check.Above("max_refine_shift_cells", max_refine_shift_cells, 0.0);
+  check.AtLeast("sharpening", sharpening, 0.0);
+  check.Nested("edges", edges);
+  return check.ok();
 }
 
 namespace {

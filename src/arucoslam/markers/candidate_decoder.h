@@ -6,6 +6,7 @@
 #include <opencv2/aruco.hpp>
 #include <opencv2/core.hpp>
 #include <optional>
+#include <string>
 
 #include "arucoslam/markers/edge_refiner.h"
 
@@ -35,7 +36,7 @@ struct CandidateDecoderOptions {
   bool ring_threshold = true;
   double sharpening = 0.25;
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 struct DecodedCandidate {

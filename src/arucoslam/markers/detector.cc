@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "arucoslam/markers/dictionary.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -19,27 +20,44 @@ double MarkerDetection::Perimeter() const {
   return perimeter;
 }
 
-bool DetectorOptions::Check() const {
-  return IsDictionaryName(dictionary) && adaptive_thresh_win_size_min >= 3 &&
-         adaptive_thresh_win_size_max >= adaptive_thresh_win_size_min &&
-         adaptive_thresh_win_size_step > 0 && min_marker_perimeter_rate > 0.0 &&
-         max_marker_perimeter_rate > min_marker_perimeter_rate &&
-         polygonal_approx_accuracy_rate > 0.0 && min_corner_distance_rate >= 0.0 &&
-         min_distance_to_border >= 0 && min_marker_distance_rate >= 0.0 &&
-         corner_refinement_win_size >= 2 && corner_refinement_window_cells > 0.0 &&
-         corner_refinement_max_iterations >= 1 && corner_refinement_min_accuracy > 0.0 &&
-         perspective_remove_pixel_per_cell >= 1 &&
-         perspective_remove_ignored_margin_per_cell >= 0.0 &&
-         perspective_remove_ignored_margin_per_cell < 0.5 &&
-         max_erroneous_bits_in_border_rate >= 0.0 && min_otsu_std_dev >= 0.0 &&
-         error_correction_rate >= 0.0 && error_correction_rate <= 1.0 &&
-         dedup_distance_rate >= 0.0 && marker_border_bits >= 1 &&
-         (april_tag_quad_decimate == 0.0 || april_tag_quad_decimate >= 1.0) &&
-         april_tag_quad_sigma >= 0.0 && upsample >= 1.0 && upsample <= 8.0 && rescue.Check() &&
-         threshold_fit.Check() && april_tag_quad_match_cells > 0.0 &&
-         edge_refinement_min_side_px >= 0.0 &&
-         edge_refinement_max_side_px >= edge_refinement_min_side_px &&
-         edge_refinement_options.Check();
+bool DetectorOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.Rule(IsDictionaryName(dictionary), "dictionary", dictionary, "a dictionary name");
+  check.AtLeast("adaptive_thresh_win_size_min", adaptive_thresh_win_size_min, 3);
+  check.AtLeast("adaptive_thresh_win_size_max", adaptive_thresh_win_size_max,
+                adaptive_thresh_win_size_min, "adaptive_thresh_win_size_min");
+  check.Above("adaptive_thresh_win_size_step", adaptive_thresh_win_size_step, 0);
+  check.Above("min_marker_perimeter_rate", min_marker_perimeter_rate, 0.0);
+  check.Above("max_marker_perimeter_rate", max_marker_perimeter_rate, min_marker_perimeter_rate,
+              "min_marker_perimeter_rate");
+  check.Above("polygonal_approx_accuracy_rate", polygonal_approx_accuracy_rate, 0.0);
+  check.AtLeast("min_corner_distance_rate", min_corner_distance_rate, 0.0);
+  check.AtLeast("min_distance_to_border", min_distance_to_border, 0);
+  check.AtLeast("min_marker_distance_rate", min_marker_distance_rate, 0.0);
+  check.AtLeast("corner_refinement_win_size", corner_refinement_win_size, 2);
+  check.Above("corner_refinement_window_cells", corner_refinement_window_cells, 0.0);
+  check.AtLeast("corner_refinement_max_iterations", corner_refinement_max_iterations, 1);
+  check.Above("corner_refinement_min_accuracy", corner_refinement_min_accuracy, 0.0);
+  check.AtLeast("perspective_remove_pixel_per_cell", perspective_remove_pixel_per_cell, 1);
+  check.InRange("perspective_remove_ignored_margin_per_cell",
+                perspective_remove_ignored_margin_per_cell, 0.0, 0.5, Interval::kClosedOpen);
+  check.AtLeast("max_erroneous_bits_in_border_rate", max_erroneous_bits_in_border_rate, 0.0);
+  check.AtLeast("min_otsu_std_dev", min_otsu_std_dev, 0.0);
+  check.InRange("error_correction_rate", error_correction_rate, 0.0, 1.0, Interval::kClosed);
+  check.AtLeast("dedup_distance_rate", dedup_distance_rate, 0.0);
+  check.AtLeast("marker_border_bits", marker_border_bits, 1);
+  check.Rule(april_tag_quad_decimate == 0.0 || april_tag_quad_decimate >= 1.0,
+             "april_tag_quad_decimate", april_tag_quad_decimate, "0 or >= 1");
+  check.AtLeast("april_tag_quad_sigma", april_tag_quad_sigma, 0.0);
+  check.InRange("upsample", upsample, 1.0, 8.0, Interval::kClosed);
+  check.Nested("rescue", rescue);
+  check.Nested("threshold_fit", threshold_fit);
+  check.Above("april_tag_quad_match_cells", april_tag_quad_match_cells, 0.0);
+  check.AtLeast("edge_refinement_min_side_px", edge_refinement_min_side_px, 0.0);
+  check.AtLeast("edge_refinement_max_side_px", edge_refinement_max_side_px,
+                edge_refinement_min_side_px, "edge_refinement_min_side_px");
+  check.Nested("edge_refinement_options", edge_refinement_options);
+  return check.ok();
 }
 
 cv::Ptr<cv::aruco::DetectorParameters> DetectorOptions::ToOpenCv() const {

@@ -135,7 +135,7 @@ struct DetectorOptions {
   bool april_tag_quad_corners = true;
   double april_tag_quad_match_cells = 1.0;  // > 0
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
   cv::Ptr<cv::aruco::DetectorParameters> ToOpenCv() const;
 };
 

@@ -6,12 +6,14 @@
 #include <array>
 #include <opencv2/core.hpp>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "arucoslam/geometry/camera.h"
 #include "arucoslam/geometry/rigid3.h"
 #include "arucoslam/markers/detector.h"
 #include "arucoslam/markers/marker_map.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -50,9 +52,13 @@ struct MarkerSearchOptions {
   // Regions covering more of the image than this save little: the whole image is searched.
   double max_region_area = 0.5;
 
-  bool Check() const {
-    return full_scan_interval >= 1 && grow_rate >= 0.0 && pose_margin_px >= 0.0 &&
-           max_region_area >= 0.0;
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.AtLeast("full_scan_interval", full_scan_interval, 1);
+    check.AtLeast("grow_rate", grow_rate, 0.0);
+    check.AtLeast("pose_margin_px", pose_margin_px, 0.0);
+    check.AtLeast("max_region_area", max_region_area, 0.0);
+    return check.ok();
   }
 };
 

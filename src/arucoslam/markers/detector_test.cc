@@ -489,6 +489,11 @@ TEST(MarkerDetectorTest, OptionsAreChecked) {
   DetectorOptions bad_rescue;
   bad_rescue.rescue.ignored_margin_per_cell = 0.5;
   EXPECT_FALSE(bad_rescue.Check());
+  std::string why;
+  EXPECT_FALSE(bad_rescue.Check(&why));
+  EXPECT_EQ(why, "rescue.ignored_margin_per_cell must be in [0, 0.5), is 0.5");
+  EXPECT_FALSE(small_upsample.Check(&why));
+  EXPECT_EQ(why, "upsample must be in [1, 8], is 0.5");
   EXPECT_THROW(MarkerDetector{options}, std::invalid_argument);
   DetectorOptions unknown;
   unknown.dictionary = "DICT_9X9_7";

@@ -5,6 +5,8 @@
 #include <array>
 #include <opencv2/core.hpp>
 
+#include "arucoslam/util/option_check.h"
+
 namespace arucoslam {
 
 struct EdgeRefineOptions {
@@ -22,10 +24,15 @@ struct EdgeRefineOptions {
   // markers of 15-30 px: 0.05-0.07 px RMS corner error against 0.06-0.11 px with 1).
   double derivative_half_width_px = 1.0;
 
-  bool Check() const {
-    return search_cells > 0.0 && derivative_half_width_px > 0.0 && iterations >= 1 &&
-           min_edge_fraction >= 0.0 && min_edge_fraction <= 1.0 && min_step >= 0.0 &&
-           max_shift_cells > 0.0;
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.Above("search_cells", search_cells, 0.0);
+    check.Above("derivative_half_width_px", derivative_half_width_px, 0.0);
+    check.AtLeast("iterations", iterations, 1);
+    check.InRange("min_edge_fraction", min_edge_fraction, 0.0, 1.0, Interval::kClosed);
+    check.AtLeast("min_step", min_step, 0.0);
+    check.Above("max_shift_cells", max_shift_cells, 0.0);
+    return check.ok();
   }
 };
 

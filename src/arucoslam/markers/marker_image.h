@@ -3,15 +3,21 @@
 #pragma once
 
 #include <opencv2/core.hpp>
-
 #include <string>
+
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
 struct MarkerImageOptions {
   int marker_size_px = 600;   // side of the black square (border cells included), pixels
   double quiet_zone_cells = 2.0;  // white margin on each side, in marker cells (>= 2 advised)
-  bool Check() const { return marker_size_px >= 16 && quiet_zone_cells >= 0.0; }
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.AtLeast("marker_size_px", marker_size_px, 16);
+    check.AtLeast("quiet_zone_cells", quiet_zone_cells, 0.0);
+    return check.ok();
+  }
 };
 
 // 8-bit single-channel image of marker `id` of `dictionary_name`, white margin included.

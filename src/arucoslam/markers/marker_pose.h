@@ -4,10 +4,12 @@
 
 #include <array>
 #include <optional>
+#include <string>
 
 #include "arucoslam/geometry/camera.h"
 #include "arucoslam/geometry/rigid3.h"
 #include "arucoslam/markers/detector.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -20,8 +22,11 @@ struct MarkerPoseOptions {
   double ambiguity_ratio = 0.6;        // in (0, 1]
   double min_distinct_error_px = 1.0;  // pixels, >= 0
 
-  bool Check() const {
-    return ambiguity_ratio > 0.0 && ambiguity_ratio <= 1.0 && min_distinct_error_px >= 0.0;
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.InRange("ambiguity_ratio", ambiguity_ratio, 0.0, 1.0, Interval::kOpenClosed);
+    check.AtLeast("min_distinct_error_px", min_distinct_error_px, 0.0);
+    return check.ok();
   }
 };
 

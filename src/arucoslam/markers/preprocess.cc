@@ -4,20 +4,30 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "arucoslam/util/option_check.h"
+
 namespace arucoslam {
 
-bool PreprocessOptions::Check() const {
-  if (clahe && (!(clahe_clip_limit > 0.0) || clahe_tile_grid < 1)) return false;
+bool PreprocessOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  if (clahe) {
+    check.Above("clahe_clip_limit", clahe_clip_limit, 0.0);
+    check.AtLeast("clahe_tile_grid", clahe_tile_grid, 1);
+  }
   switch (denoise) {
     case DenoiseMethod::kNone:
-      return true;
+      return check.ok();
     case DenoiseMethod::kGaussian:
-      return gaussian_sigma_px > 0.0 && std::isfinite(gaussian_sigma_px);
+      check.Rule(gaussian_sigma_px > 0.0 && std::isfinite(gaussian_sigma_px), "gaussian_sigma_px",
+                 gaussian_sigma_px, "finite and > 0");
+      return check.ok();
     case DenoiseMethod::kBilateral:
-      return bilateral_diameter_px >= 3 && bilateral_sigma_color > 0.0 &&
-             bilateral_sigma_space_px > 0.0;
+      check.AtLeast("bilateral_diameter_px", bilateral_diameter_px, 3);
+      check.Above("bilateral_sigma_color", bilateral_sigma_color, 0.0);
+      check.Above("bilateral_sigma_space_px", bilateral_sigma_space_px, 0.0);
+      return check.ok();
   }
-  return false;
+  return check.Require(false, "denoise", "a known method").ok();
 }
 
 namespace {

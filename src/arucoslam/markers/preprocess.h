@@ -20,7 +20,7 @@ struct PreprocessOptions {
   double bilateral_sigma_color = 20.0;    // kBilateral: range sigma, grey levels, > 0
   double bilateral_sigma_space_px = 3.0;  // kBilateral: spatial sigma, pixels, > 0
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 // Returns an 8-bit single-channel image: colour (BGR/BGRA) is converted to grey, 16-bit is

@@ -9,6 +9,7 @@
 #include "arucoslam/geometry/rigid3.h"
 #include "arucoslam/markers/marker_image.h"
 #include "arucoslam/markers/marker_map.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -26,7 +27,12 @@ struct MarkerModelSdfOptions {
   // Model name. Empty: MarkerModelName(id).
   std::string model_name;
 
-  bool Check() const { return image.Check() && thickness > 0.0; }
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.Nested("image", image);
+    check.Above("thickness", thickness, 0.0);
+    return check.ok();
+  }
 };
 
 // "marker_<id>": the model name (and model folder name) of a marker.

@@ -8,12 +8,18 @@
 
 #include "arucoslam/markers/dictionary.h"
 #include "arucoslam/markers/marker_image.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
-bool SyntheticViewOptions::Check() const {
-  return background_mean >= 0.0 && background_mean <= 255.0 && texture_contrast >= 0.0 &&
-         blur_sigma_px >= 0.0 && noise_sigma >= 0.0 && supersampling >= 1 && supersampling <= 8;
+bool SyntheticViewOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.InRange("background_mean", background_mean, 0.0, 255.0, Interval::kClosed);
+  check.AtLeast("texture_contrast", texture_contrast, 0.0);
+  check.AtLeast("blur_sigma_px", blur_sigma_px, 0.0);
+  check.AtLeast("noise_sigma", noise_sigma, 0.0);
+  check.InRange("supersampling", supersampling, 1, 8, Interval::kClosed);
+  return check.ok();
 }
 
 namespace {

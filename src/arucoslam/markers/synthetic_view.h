@@ -35,7 +35,7 @@ struct SyntheticViewOptions {
   int supersampling = 3;           // sub-pixels per pixel side when warping, >= 1
   std::uint64_t seed = 1;          // texture and noise are deterministic from the seed
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 // The pinhole camera of the synthetic marker tests: 640x480, fx = fy = 500, principal point

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "arucoslam/markers/line_fit.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 namespace {
@@ -204,10 +205,17 @@ std::vector<Crossing> FindCrossings(const cv::Mat& gray, cv::Rect window,
 
 }  // namespace
 
-bool ThresholdLineFitOptions::Check() const {
-  return tile_px >= 2 && min_contrast >= 0.0 && band_cells > 0.0 && min_band_px >= 0.0 &&
-         max_band_px >= min_band_px && iterations >= 1 && min_points_per_side >= 2 &&
-         max_shift_cells > 0.0;
+bool ThresholdLineFitOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.AtLeast("tile_px", tile_px, 2);
+  check.AtLeast("min_contrast", min_contrast, 0.0);
+  check.Above("band_cells", band_cells, 0.0);
+  check.AtLeast("min_band_px", min_band_px, 0.0);
+  check.AtLeast("max_band_px", max_band_px, min_band_px, "min_band_px");
+  check.AtLeast("iterations", iterations, 1);
+  check.AtLeast("min_points_per_side", min_points_per_side, 2);
+  check.Above("max_shift_cells", max_shift_cells, 0.0);
+  return check.ok();
 }
 
 bool FitQuadToThreshold(const cv::Mat& gray, int cells, const ThresholdLineFitOptions& options,

@@ -25,7 +25,7 @@ struct ThresholdLineFitOptions {
   int min_points_per_side = 3;
   double max_shift_cells = 0.75;  // a corner moving further fails the fit
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 // `corners` in either winding, `cells` cells across (border included); pixel centres at

@@ -4,11 +4,19 @@
 
 #include <cmath>
 
+#include "arucoslam/util/option_check.h"
+
 namespace arucoslam {
 
-bool BundleAdjustmentOptions::Check() const {
-  return max_iterations >= 1 && huber_delta_px > 0.0 && chi_square_threshold > 0.0 &&
-         num_threads >= 1 && function_tolerance > 0.0 && min_iterations_before_stop >= 0;
+bool BundleAdjustmentOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.AtLeast("max_iterations", max_iterations, 1);
+  check.Above("huber_delta_px", huber_delta_px, 0.0);
+  check.Above("chi_square_threshold", chi_square_threshold, 0.0);
+  check.AtLeast("num_threads", num_threads, 1);
+  check.Above("function_tolerance", function_tolerance, 0.0);
+  check.AtLeast("min_iterations_before_stop", min_iterations_before_stop, 0);
+  return check.ok();
 }
 
 bool BundleAdjustmentProblem::Check(std::string* reason) const {

@@ -32,7 +32,7 @@ struct BundleAdjustmentOptions {
   std::function<bool()> stop_requested;
   int min_iterations_before_stop = 1;
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 // The problem; the solver changes poses and points in place (all but the fixed ones).

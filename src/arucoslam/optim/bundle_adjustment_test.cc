@@ -63,6 +63,9 @@ TEST(BundleAdjustmentTest, OptionsAndProblemChecks) {
   BundleAdjustmentOptions options;
   options.huber_delta_px = -1.0;
   EXPECT_FALSE(options.Check());
+  std::string why;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_EQ(why, "huber_delta_px must be > 0, is -1");
 
   BundleAdjustmentProblem problem = MakeSyntheticScene({});
   std::string reason;

@@ -4,10 +4,12 @@
 
 #include <map>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "arucoslam/map/map.h"
 #include "arucoslam/optim/pose_graph.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -37,9 +39,14 @@ struct EssentialGraphOptions {
   double edge_rotation_sigma = 1.0;
   double edge_scale_sigma = 1.0;
 
-  bool Check() const {
-    return solver.Check() && min_covisibility_weight > 0 && edge_translation_sigma > 0.0 &&
-           edge_rotation_sigma > 0.0 && edge_scale_sigma > 0.0;
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.Nested("solver", solver);
+    check.Above("min_covisibility_weight", min_covisibility_weight, 0);
+    check.Above("edge_translation_sigma", edge_translation_sigma, 0.0);
+    check.Above("edge_rotation_sigma", edge_rotation_sigma, 0.0);
+    check.Above("edge_scale_sigma", edge_scale_sigma, 0.0);
+    return check.ok();
   }
 };
 

@@ -3,12 +3,14 @@
 // snapshot (read lock), solve (no lock), apply with corrections (write lock).
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "arucoslam/map/map.h"
 #include "arucoslam/map/marker_landmark.h"
 #include "arucoslam/optim/bundle_adjustment.h"
 #include "arucoslam/optim/marker_factors.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -24,7 +26,13 @@ struct GlobalBundleAdjustmentOptions {
   // holds position, orientation and scale: no keyframe is fixed then.
   MarkerFactorOptions markers;
 
-  bool Check() const { return solver.Check() && num_fixed_keyframes >= 1 && markers.Check(); }
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.Nested("solver", solver);
+    check.AtLeast("num_fixed_keyframes", num_fixed_keyframes, 1);
+    check.Nested("markers", markers);
+    return check.ok();
+  }
 };
 
 // The whole map as a BundleAdjustmentProblem plus the ids behind its indices and the poses

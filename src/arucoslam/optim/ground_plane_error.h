@@ -3,9 +3,11 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <string>
 #include <vector>
 
 #include "arucoslam/geometry/rigid3.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -15,7 +17,12 @@ struct GroundPlanePriorOptions {
   double height_sigma_m = 0.01;
   double tilt_sigma_rad = 0.005;
 
-  bool Check() const { return height_sigma_m > 0.0 && tilt_sigma_rad > 0.0; }
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.Above("height_sigma_m", height_sigma_m, 0.0);
+    check.Above("tilt_sigma_rad", tilt_sigma_rad, 0.0);
+    return check.ok();
+  }
 };
 
 // The plane a ground vehicle's camera moves in: its height (world z of the camera centre) and

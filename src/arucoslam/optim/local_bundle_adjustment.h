@@ -2,10 +2,13 @@
 // a Map (snapshot under a read lock, Ceres without the lock, results written back in one go).
 #pragma once
 
+#include <string>
+
 #include "arucoslam/map/map.h"
 #include "arucoslam/map/marker_landmark.h"
 #include "arucoslam/optim/bundle_adjustment.h"
 #include "arucoslam/optim/marker_factors.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -32,9 +35,15 @@ struct LocalBundleAdjustmentOptions {
   // Marker-corner residuals of the window's keyframes (when markers are given).
   MarkerFactorOptions markers;
 
-  bool Check() const {
-    return solver.Check() && max_covisible_keyframes >= 0 && min_fixed_keyframes >= 0 &&
-           min_anchor_points >= 0 && min_relative_depth >= 0.0 && markers.Check();
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.Nested("solver", solver);
+    check.AtLeast("max_covisible_keyframes", max_covisible_keyframes, 0);
+    check.AtLeast("min_fixed_keyframes", min_fixed_keyframes, 0);
+    check.AtLeast("min_anchor_points", min_anchor_points, 0);
+    check.AtLeast("min_relative_depth", min_relative_depth, 0.0);
+    check.Nested("markers", markers);
+    return check.ok();
   }
 };
 

@@ -13,6 +13,7 @@
 #include "arucoslam/optim/ground_plane_error.h"
 #include "arucoslam/optim/marker_corner_error.h"
 #include "arucoslam/optim/position_prior_error.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -29,8 +30,12 @@ struct MarkerBundleAdjustmentOptions {
   // A marker observation with |r|^2 / sigma^2 above this after the solve is an outlier.
   double marker_chi_square_threshold = kChiSquare8Dof95;
 
-  bool Check() const {
-    return solver.Check() && marker_huber_delta > 0.0 && marker_chi_square_threshold > 0.0;
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.Nested("solver", solver);
+    check.Above("marker_huber_delta", marker_huber_delta, 0.0);
+    check.Above("marker_chi_square_threshold", marker_chi_square_threshold, 0.0);
+    return check.ok();
   }
 };
 

@@ -4,6 +4,7 @@
 #include <random>
 
 #include "arucoslam/markers/marker_pose.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 namespace {
@@ -28,10 +29,20 @@ Rigid3 FacingMarkerPose(const Eigen::Vector3d& position, double yaw) {
 
 }  // namespace
 
-bool SyntheticMarkerSceneOptions::Check() const {
-  return num_poses >= 2 && path_length_m > 0.0 && num_points >= 0 && num_markers >= 0 &&
-         marker_size_m > 0.0 && max_marker_distance_m > 0.0 && noise_px >= 0.0 &&
-         corner_noise_px >= 0.0 && image_width > 0 && image_height > 0 && focal_px > 0.0;
+bool SyntheticMarkerSceneOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.AtLeast("num_poses", num_poses, 2);
+  check.Above("path_length_m", path_length_m, 0.0);
+  check.AtLeast("num_points", num_points, 0);
+  check.AtLeast("num_markers", num_markers, 0);
+  check.Above("marker_size_m", marker_size_m, 0.0);
+  check.Above("max_marker_distance_m", max_marker_distance_m, 0.0);
+  check.AtLeast("noise_px", noise_px, 0.0);
+  check.AtLeast("corner_noise_px", corner_noise_px, 0.0);
+  check.Above("image_width", image_width, 0);
+  check.Above("image_height", image_height, 0);
+  check.Above("focal_px", focal_px, 0.0);
+  return check.ok();
 }
 
 MarkerBundleAdjustmentProblem MakeSyntheticMarkerScene(const SyntheticMarkerSceneOptions& options) {

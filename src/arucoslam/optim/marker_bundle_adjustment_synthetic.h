@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 #include "arucoslam/optim/marker_bundle_adjustment.h"
 
@@ -23,7 +24,7 @@ struct SyntheticMarkerSceneOptions {
   double focal_px = 500.0;  // fx = fy; principal point at the image centre
   std::uint32_t seed = 1;
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 // The true scene, every marker `fixed`. Observation sigmas are 1 px. Deterministic for a seed.

@@ -3,6 +3,7 @@
 // joint solve, and marker pose priors for a pose graph. Shared by local and global BA.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "arucoslam/map/map_data.h"
@@ -11,6 +12,7 @@
 #include "arucoslam/optim/essential_graph.h"
 #include "arucoslam/optim/marker_bundle_adjustment.h"
 #include "arucoslam/optim/pose_graph.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -30,11 +32,17 @@ struct MarkerFactorOptions {
   double prior_reference_distance_sides = 0.0;
   double max_prior_distance_sides = 0.0;
 
-  bool Check() const {
-    return corner_sigma_px > 0.0 && marker_huber_delta > 0.0 &&
-           marker_chi_square_threshold > 0.0 && min_prior_markers >= 1 &&
-           prior_position_sigma_m > 0.0 && prior_rotation_sigma_rad > 0.0 &&
-           prior_reference_distance_sides >= 0.0 && max_prior_distance_sides >= 0.0;
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.Above("corner_sigma_px", corner_sigma_px, 0.0);
+    check.Above("marker_huber_delta", marker_huber_delta, 0.0);
+    check.Above("marker_chi_square_threshold", marker_chi_square_threshold, 0.0);
+    check.AtLeast("min_prior_markers", min_prior_markers, 1);
+    check.Above("prior_position_sigma_m", prior_position_sigma_m, 0.0);
+    check.Above("prior_rotation_sigma_rad", prior_rotation_sigma_rad, 0.0);
+    check.AtLeast("prior_reference_distance_sides", prior_reference_distance_sides, 0.0);
+    check.AtLeast("max_prior_distance_sides", max_prior_distance_sides, 0.0);
+    return check.ok();
   }
 };
 

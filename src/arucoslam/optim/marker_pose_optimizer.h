@@ -3,10 +3,12 @@
 #pragma once
 
 #include <array>
+#include <string>
 #include <vector>
 
 #include "arucoslam/optim/marker_bundle_adjustment.h"
 #include "arucoslam/optim/pose_optimizer.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -28,8 +30,12 @@ struct MarkerPoseOptimizationOptions {
   // |r|^2 / sigma^2 of a marker above this makes it an outlier (chi-square, 8 dof, 95%).
   double marker_chi_square_threshold = kChiSquare8Dof95;
 
-  bool Check() const {
-    return keypoints.Check() && marker_huber_delta > 0.0 && marker_chi_square_threshold > 0.0;
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.Nested("keypoints", keypoints);
+    check.Above("marker_huber_delta", marker_huber_delta, 0.0);
+    check.Above("marker_chi_square_threshold", marker_chi_square_threshold, 0.0);
+    return check.ok();
   }
 };
 

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "arucoslam/optim/pose_graph_residuals.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 namespace {
@@ -26,8 +27,12 @@ pose_graph_internal::SimilarityT<double> ToSimilarity(const Sim3& s) {
 
 }  // namespace
 
-bool PoseGraphOptions::Check() const {
-  return max_iterations > 0 && function_tolerance > 0.0 && num_threads > 0;
+bool PoseGraphOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.Above("max_iterations", max_iterations, 0);
+  check.Above("function_tolerance", function_tolerance, 0.0);
+  check.Above("num_threads", num_threads, 0);
+  return check.ok();
 }
 
 bool PoseGraphProblem::Check(std::string* reason) const {

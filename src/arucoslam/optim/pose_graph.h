@@ -25,7 +25,7 @@ struct PoseGraphOptions {
   bool fix_scale = false;
   int num_threads = 1;  // solver threads
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 struct PoseGraphProblem {

@@ -3,6 +3,8 @@
 #include <Eigen/Cholesky>
 #include <cmath>
 
+#include "arucoslam/util/option_check.h"
+
 namespace arucoslam {
 namespace {
 
@@ -121,9 +123,15 @@ double RmsPixels(const std::vector<PoseObservation>& observations, const std::ve
 
 }  // namespace
 
-bool PoseOptimizationOptions::Check() const {
-  return num_rounds >= 1 && iterations_per_round >= 1 && num_robust_rounds >= 0 &&
-         huber_delta > 0.0 && chi_square_threshold > 0.0 && min_inliers >= 3;
+bool PoseOptimizationOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.AtLeast("num_rounds", num_rounds, 1);
+  check.AtLeast("iterations_per_round", iterations_per_round, 1);
+  check.AtLeast("num_robust_rounds", num_robust_rounds, 0);
+  check.Above("huber_delta", huber_delta, 0.0);
+  check.Above("chi_square_threshold", chi_square_threshold, 0.0);
+  check.AtLeast("min_inliers", min_inliers, 3);
+  return check.ok();
 }
 
 PoseOptimizationResult OptimizePose(const std::vector<PoseObservation>& observations,

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <string>
 #include <vector>
 
 #include "arucoslam/geometry/rigid3.h"
@@ -32,7 +33,7 @@ struct PoseOptimizationOptions {
   // Fewer inliers than this after a round: stop, the result is reported as failed.
   int min_inliers = 10;
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 struct PoseOptimizationResult {

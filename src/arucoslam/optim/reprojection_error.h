@@ -6,6 +6,7 @@
 
 #include "arucoslam/geometry/camera.h"
 #include "arucoslam/geometry/rigid3.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -18,7 +19,12 @@ struct PinholeIntrinsics {
   static PinholeIntrinsics FromCamera(const CameraModel& camera) {
     return {camera.fx, camera.fy, camera.cx, camera.cy};
   }
-  bool Check() const { return fx > 0.0 && fy > 0.0; }
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.Above("fx", fx, 0.0);
+    check.Above("fy", fy, 0.0);
+    return check.ok();
+  }
   // Normalised undistorted coordinates (x/z, y/z) -> undistorted pixel.
   Eigen::Vector2d ToPixel(const Eigen::Vector2d& normalised) const {
     return {fx * normalised.x() + cx, fy * normalised.y() + cy};

@@ -2,10 +2,17 @@
 
 #include <cmath>
 
+#include "arucoslam/util/option_check.h"
+
 namespace arucoslam {
 
-bool SyntheticLoopOptions::Check() const {
-  return num_keyframes >= 3 && radius_m > 0.0 && scale_drift > 0.0 && covisibility_span >= 1;
+bool SyntheticLoopOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.AtLeast("num_keyframes", num_keyframes, 3);
+  check.Above("radius_m", radius_m, 0.0);
+  check.Above("scale_drift", scale_drift, 0.0);
+  check.AtLeast("covisibility_span", covisibility_span, 1);
+  return check.ok();
 }
 
 SyntheticLoop MakeSyntheticLoop(const SyntheticLoopOptions& options) {

@@ -2,6 +2,7 @@
 // accumulated rotation and scale drift, covisibility edges and one loop edge back to the start.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "arucoslam/optim/pose_graph.h"
@@ -16,7 +17,7 @@ struct SyntheticLoopOptions {
   int covisibility_span = 2;       // edges i -> i+1 .. i+span (span >= 1)
   bool scale_in_loop_edge = true;  // monocular: the loop edge carries the scale drift
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 struct SyntheticLoop {

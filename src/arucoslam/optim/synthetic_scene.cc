@@ -2,12 +2,22 @@
 
 #include <random>
 
+#include "arucoslam/util/option_check.h"
+
 namespace arucoslam {
 
-bool SyntheticSceneOptions::Check() const {
-  return num_poses >= 1 && num_points >= 1 && baseline_m >= 0.0 && min_depth_m > 0.0 &&
-         max_depth_m > min_depth_m && noise_px >= 0.0 && image_width > 0 && image_height > 0 &&
-         focal_px > 0.0;
+bool SyntheticSceneOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.AtLeast("num_poses", num_poses, 1);
+  check.AtLeast("num_points", num_points, 1);
+  check.AtLeast("baseline_m", baseline_m, 0.0);
+  check.Above("min_depth_m", min_depth_m, 0.0);
+  check.Above("max_depth_m", max_depth_m, min_depth_m, "min_depth_m");
+  check.AtLeast("noise_px", noise_px, 0.0);
+  check.Above("image_width", image_width, 0);
+  check.Above("image_height", image_height, 0);
+  check.Above("focal_px", focal_px, 0.0);
+  return check.ok();
 }
 
 BundleAdjustmentProblem MakeSyntheticScene(const SyntheticSceneOptions& options) {

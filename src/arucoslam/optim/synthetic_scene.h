@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 #include "arucoslam/optim/bundle_adjustment.h"
 
@@ -20,7 +21,7 @@ struct SyntheticSceneOptions {
   double focal_px = 500.0;  // fx = fy; principal point at the image centre
   std::uint32_t seed = 1;
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 // The true scene: poses and points exact, observations with `noise_px` Gaussian noise and

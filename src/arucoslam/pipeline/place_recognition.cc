@@ -6,12 +6,20 @@
 
 #include "arucoslam/slam/marker_candidates.h"
 #include "arucoslam/util/logging.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
-bool PlaceRecognitionOptions::Check() const {
-  return database.Check() && relocalizer.Check() && detector.Check() && closer.Check() &&
-         global_ba.Check() && loop_queue_capacity >= 1 && max_marker_candidates >= 0;
+bool PlaceRecognitionOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.Nested("database", database);
+  check.Nested("relocalizer", relocalizer);
+  check.Nested("detector", detector);
+  check.Nested("closer", closer);
+  check.Nested("global_ba", global_ba);
+  check.AtLeast("loop_queue_capacity", loop_queue_capacity, 1);
+  check.AtLeast("max_marker_candidates", max_marker_candidates, 0);
+  return check.ok();
 }
 
 PlaceRecognition::PlaceRecognition(Map& map, std::shared_ptr<const Vocabulary> vocabulary,

@@ -9,6 +9,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -38,7 +39,7 @@ struct PlaceRecognitionOptions {
   // many keyframes that saw the frame's markers (most shared ids first) are tried. 0: off.
   int max_marker_candidates = 5;
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 // One closed loop, for logs and for checking it against ground truth.

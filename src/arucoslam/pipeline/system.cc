@@ -5,6 +5,7 @@
 
 #include "arucoslam/feature/undistort.h"
 #include "arucoslam/util/logging.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 namespace {
@@ -18,26 +19,55 @@ void WaitIgnoringErrors(MarkerDetectorWorker& worker) {
 
 }  // namespace
 
-bool SystemOptions::Check() const {
-  return extractor.Check() && initializer.Check() && initial_map.Check() && tracker.Check() &&
-         keyframes.Check() && mapper.Check() && mapper_queue_capacity >= 1 &&
-         max_initialization_gap_s > 0.0 && reset_max_keyframes >= 0 && pose_consistency.Check() &&
-         synchronous_young_map_keyframes >= 0 && detector.Check() && locator.Check() &&
-         alignment.Check() && max_marker_rms_px > 0.0 && max_marker_distance_sides > 0.0 &&
-         ambiguity_gates.Check() && fix_motion.Check() && min_alignment_anchors >= 2 &&
-         min_alignment_baseline_m >= 0.0 && max_alignment_rms_m > 0.0 &&
-         max_alignment_scale > 0.0 && marker_reset_lost_frames >= 1 &&
-         max_realignment_anchors >= min_alignment_anchors && places.Check() &&
-         max_marker_disagreement_m > 0.0 && min_drift_interval_s >= 0.0 &&
-         max_drift_correction_frames >= 1 && max_drift_step_m >= 0.0 &&
-         min_frames_between_anchor_keyframes >= 0 && marker_mapping.Check() &&
-         new_map_after_lost_s > 0.0 && min_marker_init_baseline_m > 0.0 &&
-         min_marker_init_parallax_deg >= 0.0 && marker_search.Check() && rotation_vote.Check() &&
-         map_rotation_gates.Check() && refine_min_inlier_fraction > 0.0 &&
-         refine_min_inlier_fraction <= 1.0 && bridge_motion.Check() &&
-         bridge_position_sigma_m > 0.0 && bridge_position_sigma_per_s >= 0.0 &&
-         bridge_max_acceleration_m_s2 >= 0.0 && bridge_rotation_sigma_rad > 0.0 &&
-         bridge_rotation_sigma_per_s >= 0.0;
+bool SystemOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.Nested("extractor", extractor);
+  check.Nested("initializer", initializer);
+  check.Nested("initial_map", initial_map);
+  check.Nested("tracker", tracker);
+  check.Nested("keyframes", keyframes);
+  check.Nested("mapper", mapper);
+  check.AtLeast("mapper_queue_capacity", mapper_queue_capacity, 1);
+  check.Above("max_initialization_gap_s", max_initialization_gap_s, 0.0);
+  check.AtLeast("reset_max_keyframes", reset_max_keyframes, 0);
+  check.Nested("pose_consistency", pose_consistency);
+  check.AtLeast("synchronous_young_map_keyframes", synchronous_young_map_keyframes, 0);
+  check.Nested("detector", detector);
+  check.Nested("locator", locator);
+  check.Nested("alignment", alignment);
+  check.Above("max_marker_rms_px", max_marker_rms_px, 0.0);
+  check.Above("max_marker_distance_sides", max_marker_distance_sides, 0.0);
+  check.Nested("ambiguity_gates", ambiguity_gates);
+  check.Nested("fix_motion", fix_motion);
+  check.AtLeast("min_alignment_anchors", min_alignment_anchors, 2);
+  check.AtLeast("min_alignment_baseline_m", min_alignment_baseline_m, 0.0);
+  check.Above("max_alignment_rms_m", max_alignment_rms_m, 0.0);
+  check.Above("max_alignment_scale", max_alignment_scale, 0.0);
+  check.AtLeast("marker_reset_lost_frames", marker_reset_lost_frames, 1);
+  check.AtLeast("max_realignment_anchors", max_realignment_anchors, min_alignment_anchors,
+                "min_alignment_anchors");
+  check.Nested("places", places);
+  check.Above("max_marker_disagreement_m", max_marker_disagreement_m, 0.0);
+  check.AtLeast("min_drift_interval_s", min_drift_interval_s, 0.0);
+  check.AtLeast("max_drift_correction_frames", max_drift_correction_frames, 1);
+  check.AtLeast("max_drift_step_m", max_drift_step_m, 0.0);
+  check.AtLeast("min_frames_between_anchor_keyframes", min_frames_between_anchor_keyframes, 0);
+  check.Nested("marker_mapping", marker_mapping);
+  check.Above("new_map_after_lost_s", new_map_after_lost_s, 0.0);
+  check.Above("min_marker_init_baseline_m", min_marker_init_baseline_m, 0.0);
+  check.AtLeast("min_marker_init_parallax_deg", min_marker_init_parallax_deg, 0.0);
+  check.Nested("marker_search", marker_search);
+  check.Nested("rotation_vote", rotation_vote);
+  check.Nested("map_rotation_gates", map_rotation_gates);
+  check.InRange("refine_min_inlier_fraction", refine_min_inlier_fraction, 0.0, 1.0,
+                Interval::kOpenClosed);
+  check.Nested("bridge_motion", bridge_motion);
+  check.Above("bridge_position_sigma_m", bridge_position_sigma_m, 0.0);
+  check.AtLeast("bridge_position_sigma_per_s", bridge_position_sigma_per_s, 0.0);
+  check.AtLeast("bridge_max_acceleration_m_s2", bridge_max_acceleration_m_s2, 0.0);
+  check.Above("bridge_rotation_sigma_rad", bridge_rotation_sigma_rad, 0.0);
+  check.AtLeast("bridge_rotation_sigma_per_s", bridge_rotation_sigma_per_s, 0.0);
+  return check.ok();
 }
 
 System::System(const CameraModel& camera, const SystemOptions& options)
@@ -45,7 +75,9 @@ System::System(const CameraModel& camera, const SystemOptions& options)
       options_(options),
       extractor_(options.extractor),
       initializer_(options.initializer) {
-  if (!options_.Check()) throw std::invalid_argument("System: invalid SystemOptions");
+  if (std::string why; !options_.Check(&why)) {
+    throw std::invalid_argument("System: invalid SystemOptions: " + why);
+  }
   map_ = std::make_unique<Map>();
   tracker_ = std::make_unique<Tracker>(*map_, options_.tracker);
   MakeLocalMapper();

@@ -266,7 +266,7 @@ struct SystemOptions {
   bool drop_inconsistent_poses = true;
   PoseConsistencyOptions pose_consistency;
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 struct FrameReport {

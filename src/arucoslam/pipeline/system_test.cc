@@ -89,6 +89,26 @@ TEST(System, OptionsCheck) {
   EXPECT_THROW(System(TestCamera(), options), std::invalid_argument);
 }
 
+TEST(System, OptionsCheckSaysWhichValueIsWrong) {
+  SystemOptions options;
+  options.mapper.bundle_adjustment.solver.max_iterations = 0;
+  std::string why;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_EQ(why, "mapper.bundle_adjustment.solver.max_iterations must be >= 1, is 0");
+  options = {};
+  options.refine_min_inlier_fraction = 1.5;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_EQ(why, "refine_min_inlier_fraction must be in (0, 1], is 1.5");
+  try {
+    System system(TestCamera(), options);
+    ADD_FAILURE() << "no exception";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_STREQ(error.what(),
+                 "System: invalid SystemOptions: refine_min_inlier_fraction must be in (0, 1], is "
+                 "1.5");
+  }
+}
+
 TEST(System, BlockingRunTracksSyntheticSequenceAccurately) {
   const int num_frames = 80;
   const RunResult run = RunSynthetic(true, num_frames);

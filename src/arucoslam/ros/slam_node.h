@@ -19,6 +19,7 @@
 #include <image_transport/image_transport.h>
 
 #include "arucoslam/ros/slam_session.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -36,9 +37,15 @@ struct SlamNodeParameters {
   double position_sigma_m = 0.02;  // nominal standard deviations in ~pose's covariance
   double rotation_sigma_rad = 0.01;
 
-  bool Check() const {
-    return queue_size >= 1 && map_period_s >= 0.0 && position_sigma_m > 0.0 &&
-           rotation_sigma_rad > 0.0 && !world_frame.empty() && !camera_frame.empty();
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.AtLeast("queue_size", queue_size, 1);
+    check.AtLeast("map_period_s", map_period_s, 0.0);
+    check.Above("position_sigma_m", position_sigma_m, 0.0);
+    check.Above("rotation_sigma_rad", rotation_sigma_rad, 0.0);
+    check.Require(!world_frame.empty(), "world_frame", "non-empty");
+    check.Require(!camera_frame.empty(), "camera_frame", "non-empty");
+    return check.ok();
   }
 };
 

@@ -9,12 +9,14 @@
 #include <memory>
 #include <opencv2/core.hpp>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "arucoslam/geometry/camera.h"
 #include "arucoslam/geometry/rigid3.h"
 #include "arucoslam/markers/marker_map.h"
 #include "arucoslam/ros/frame_status.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -30,7 +32,11 @@ struct SlamSessionOptions {
   // mapped before Process returns (deterministic).
   bool blocking = false;
 
-  bool Check() const { return num_features >= 100; }
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.AtLeast("num_features", num_features, 100);
+    return check.ok();
+  }
 };
 
 struct SlamUpdate {

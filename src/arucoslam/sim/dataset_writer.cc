@@ -1,18 +1,19 @@
 #include "arucoslam/sim/dataset_writer.h"
 
 #include <fmt/format.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <future>
+#include <opencv2/imgcodecs.hpp>
 #include <string>
 
 #include "arucoslam/io/calibration.h"
 #include "arucoslam/sim/world_model.h"
 #include "arucoslam/util/error.h"
 #include "arucoslam/util/files.h"
+#include "arucoslam/util/option_check.h"
 #include "arucoslam/util/timing.h"
 
 namespace arucoslam {
@@ -98,10 +99,14 @@ void PrintProgress(std::size_t done, std::size_t total, double seconds, bool las
 
 }  // namespace
 
-bool DatasetWriterOptions::Check() const {
-  return render.Check() && exposure_time_s >= 0.0 && motion_blur_samples >= 2 &&
-         motion_blur_samples <= 64 && png_compression >= 0 && png_compression <= 9 &&
-         start_time_ns >= 0;
+bool DatasetWriterOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.Nested("render", render);
+  check.AtLeast("exposure_time_s", exposure_time_s, 0.0);
+  check.InRange("motion_blur_samples", motion_blur_samples, 2, 64, Interval::kClosed);
+  check.InRange("png_compression", png_compression, 0, 9, Interval::kClosed);
+  check.AtLeast("start_time_ns", start_time_ns, 0);
+  return check.ok();
 }
 
 DatasetWriterOptions DefaultSensorOptions() {

@@ -24,7 +24,7 @@ struct DatasetWriterOptions {
   std::int64_t start_time_ns = 1'700'000'000'000'000'000;
   bool progress = true;            // a progress line on stderr while rendering
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 struct DatasetSummary {

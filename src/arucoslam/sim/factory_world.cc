@@ -13,6 +13,7 @@
 #include "arucoslam/markers/sdf_export.h"
 #include "arucoslam/util/error.h"
 #include "arucoslam/util/files.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 namespace {
@@ -681,13 +682,18 @@ MarkerModelSdfOptions MarkerSdfOptions(const FactoryOptions& options, int id) {
 
 }  // namespace
 
-bool FactoryOptions::Check() const {
-  return aisles >= 1 && aisles <= 8 && aisle_length_m >= 6.0 && aisle_length_m <= 60.0 &&
-         marker_size_m > 0.05 && marker_size_m <= 1.0 && markers_per_dock >= 1 &&
-         markers_per_dock <= 4 && marker_image_px >= 16 && marker_image_px <= 2048 &&
-         camera_height_m >= 0.3 && camera_height_m <= 1.0 &&
-         (wall_marker_spacing_m == 0.0 ||
-          (wall_marker_spacing_m >= 1.0 && wall_marker_spacing_m <= 20.0));
+bool FactoryOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.InRange("aisles", aisles, 1, 8, Interval::kClosed);
+  check.InRange("aisle_length_m", aisle_length_m, 6.0, 60.0, Interval::kClosed);
+  check.InRange("marker_size_m", marker_size_m, 0.05, 1.0, Interval::kOpenClosed);
+  check.InRange("markers_per_dock", markers_per_dock, 1, 4, Interval::kClosed);
+  check.InRange("marker_image_px", marker_image_px, 16, 2048, Interval::kClosed);
+  check.InRange("camera_height_m", camera_height_m, 0.3, 1.0, Interval::kClosed);
+  check.Rule(wall_marker_spacing_m == 0.0 ||
+                 (wall_marker_spacing_m >= 1.0 && wall_marker_spacing_m <= 20.0),
+             "wall_marker_spacing_m", wall_marker_spacing_m, "0 or in [1, 20]");
+  return check.ok();
 }
 
 TextureLevel TextureLevelFromName(const std::string& name) {

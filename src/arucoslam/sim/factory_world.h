@@ -37,7 +37,7 @@ struct FactoryOptions {
   int marker_image_px = 240;     // marker PNG: side of the black square, pixels
   double camera_height_m = 0.6;  // marker centres and the route's camera, [0.3, 1.0] m
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 // "low", "medium", "high" <-> TextureLevel; throws InputError("--texture", ...) otherwise.

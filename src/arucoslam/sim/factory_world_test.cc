@@ -346,3 +346,22 @@ TEST_F(FactoryWorldTest, MarkersOffAndBadOptions) {
 
 }  // namespace
 }  // namespace arucoslam
+
+namespace arucoslam {
+namespace {
+
+TEST(FactoryOptionsTest, CheckSaysWhichValueIsWrong) {
+  FactoryOptions options;
+  std::string why;
+  EXPECT_TRUE(options.Check(&why)) << why;
+  options.wall_marker_spacing_m = 0.5;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_EQ(why, "wall_marker_spacing_m must be 0 or in [1, 20], is 0.5");
+  options = {};
+  options.aisles = 9;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_EQ(why, "aisles must be in [1, 8], is 9");
+}
+
+}  // namespace
+}  // namespace arucoslam

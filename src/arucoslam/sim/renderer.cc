@@ -3,14 +3,13 @@
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/glcorearb.h>
 
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <filesystem>
 #include <map>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <optional>
 #include <stdexcept>
 
@@ -18,6 +17,7 @@
 #include "arucoslam/sim/image_effects.h"
 #include "arucoslam/util/error.h"
 #include "arucoslam/util/logging.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 namespace {
@@ -328,13 +328,24 @@ Eigen::Matrix4f ToFloat(const Eigen::Matrix4d& matrix) { return matrix.cast<floa
 
 }  // namespace
 
-bool RenderOptions::Check() const {
-  return msaa_samples >= 1 && msaa_samples <= 16 && max_anisotropy >= 1.0 && ambient >= 0.0 &&
-         sun >= 0.0 && headlight >= 0.0 && headlight_range_m > 0.0 && near_m > 0.0 &&
-         far_m > near_m && exposure_gain > 0.0 && exposure_variation >= 0.0 &&
-         exposure_variation < 1.0 && exposure_period_s > 0.0 && noise_sigma >= 0.0 &&
-         distortion_oversampling >= 1.0 && distortion_oversampling <= 4.0 &&
-         (background.array() >= 0.0).all() && (background.array() <= 1.0).all();
+bool RenderOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.InRange("msaa_samples", msaa_samples, 1, 16, Interval::kClosed);
+  check.AtLeast("max_anisotropy", max_anisotropy, 1.0);
+  check.AtLeast("ambient", ambient, 0.0);
+  check.AtLeast("sun", sun, 0.0);
+  check.AtLeast("headlight", headlight, 0.0);
+  check.Above("headlight_range_m", headlight_range_m, 0.0);
+  check.Above("near_m", near_m, 0.0);
+  check.Above("far_m", far_m, near_m, "near_m");
+  check.Above("exposure_gain", exposure_gain, 0.0);
+  check.InRange("exposure_variation", exposure_variation, 0.0, 1.0, Interval::kClosedOpen);
+  check.Above("exposure_period_s", exposure_period_s, 0.0);
+  check.AtLeast("noise_sigma", noise_sigma, 0.0);
+  check.InRange("distortion_oversampling", distortion_oversampling, 1.0, 4.0, Interval::kClosed);
+  check.Require((background.array() >= 0.0).all() && (background.array() <= 1.0).all(),
+                "background", "in [0, 1] in every channel");
+  return check.ok();
 }
 
 Eigen::Matrix4d ClipFromCamera(double fx, double fy, double cx, double cy, int width,

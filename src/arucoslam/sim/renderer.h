@@ -48,7 +48,7 @@ struct RenderOptions {
   // output is rendered and remapped through the model.
   double distortion_oversampling = 1.5;
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 // One rendered frame; images are camera.height x camera.width.

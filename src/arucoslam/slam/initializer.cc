@@ -12,6 +12,7 @@
 #include "arucoslam/geometry/triangulation.h"
 #include "arucoslam/geometry/two_view.h"
 #include "arucoslam/util/median.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 namespace {
@@ -102,14 +103,25 @@ InitializationResult Fail(InitializationResult result, InitFailure failure, std:
 
 }  // namespace
 
-bool InitializerOptions::Check() const {
-  return min_matches >= 8 && matching.Check() && ransac_iterations > 0 && sigma_px > 0.0 &&
-         homography_share > 0.0 && homography_share < 1.0 && min_median_flow_px >= 0.0 &&
-         min_translation_flow_px >= 0.0 && min_parallax_deg >= 0.0 && max_reprojection_px > 0.0 &&
-         min_triangulated >= 1 && min_triangulated_fraction >= 0.0 &&
-         min_triangulated_fraction <= 1.0 && ambiguity_ratio > 0.0 && ambiguity_ratio < 1.0 &&
-         min_epipolar_support_ratio >= 0.0 && min_epipolar_support_ratio <= 1.0 &&
-         min_axis_agreement_cos >= 0.0 && min_axis_agreement_cos <= 1.0;
+bool InitializerOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.AtLeast("min_matches", min_matches, 8);
+  check.Nested("matching", matching);
+  check.Above("ransac_iterations", ransac_iterations, 0);
+  check.Above("sigma_px", sigma_px, 0.0);
+  check.InRange("homography_share", homography_share, 0.0, 1.0, Interval::kOpen);
+  check.AtLeast("min_median_flow_px", min_median_flow_px, 0.0);
+  check.AtLeast("min_translation_flow_px", min_translation_flow_px, 0.0);
+  check.AtLeast("min_parallax_deg", min_parallax_deg, 0.0);
+  check.Above("max_reprojection_px", max_reprojection_px, 0.0);
+  check.AtLeast("min_triangulated", min_triangulated, 1);
+  check.InRange("min_triangulated_fraction", min_triangulated_fraction, 0.0, 1.0,
+                Interval::kClosed);
+  check.InRange("ambiguity_ratio", ambiguity_ratio, 0.0, 1.0, Interval::kOpen);
+  check.InRange("min_epipolar_support_ratio", min_epipolar_support_ratio, 0.0, 1.0,
+                Interval::kClosed);
+  check.InRange("min_axis_agreement_cos", min_axis_agreement_cos, 0.0, 1.0, Interval::kClosed);
+  return check.ok();
 }
 
 std::string InitFailureName(InitFailure failure) {

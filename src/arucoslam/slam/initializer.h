@@ -44,7 +44,7 @@ struct InitializerOptions {
   double min_epipolar_support_ratio = 0.9;
   double min_axis_agreement_cos = 0.866;
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 enum class InitFailure {

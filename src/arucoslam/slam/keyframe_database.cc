@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "arucoslam/util/option_check.h"
+
 namespace arucoslam {
 
 KeyframeDatabase::KeyframeDatabase(const Vocabulary& vocabulary,
@@ -32,9 +34,13 @@ void KeyframeDatabase::Add(KeyframeId id, ImageWords words) {
 
 bool KeyframeDatabase::Erase(KeyframeId id) { return database_.Erase(id); }
 
-bool CandidateGroupingOptions::Check() const {
-  return min_shared_words_ratio > 0.0 && min_shared_words_ratio <= 1.0 && group_size >= 0 &&
-         min_group_score_ratio > 0.0 && min_group_score_ratio <= 1.0 && max_candidates >= 1;
+bool CandidateGroupingOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.InRange("min_shared_words_ratio", min_shared_words_ratio, 0.0, 1.0, Interval::kOpenClosed);
+  check.AtLeast("group_size", group_size, 0);
+  check.InRange("min_group_score_ratio", min_group_score_ratio, 0.0, 1.0, Interval::kOpenClosed);
+  check.AtLeast("max_candidates", max_candidates, 1);
+  return check.ok();
 }
 
 std::vector<PlaceCandidate> GroupCandidates(

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "arucoslam/feature/place_database.h"
@@ -10,6 +11,7 @@
 #include "arucoslam/map/covisibility_graph.h"
 #include "arucoslam/map/frame.h"
 #include "arucoslam/map/ids.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -23,7 +25,11 @@ struct KeyframeDatabaseOptions {
   // Depth of the direct index's nodes (1 .. vocabulary levels; clamped to the levels): the
   // coarser, the more candidate pairs per node. Default 2: 100 nodes of a k=10 vocabulary.
   int direct_index_depth = 2;
-  bool Check() const { return direct_index_depth >= 1; }
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.AtLeast("direct_index_depth", direct_index_depth, 1);
+    return check.ok();
+  }
 };
 
 // Not thread-safe: the owner serialises calls. The vocabulary must outlive the database.
@@ -69,7 +75,7 @@ struct CandidateGroupingOptions {
   // Groups scoring below this fraction of the best group are dropped ((0, 1]).
   double min_group_score_ratio = 0.75;
   int max_candidates = 10;  // at most this many candidates are returned (>= 1)
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 struct PlaceCandidate {

@@ -1,12 +1,21 @@
 #include "arucoslam/slam/keyframe_policy.h"
 
+#include "arucoslam/util/option_check.h"
+
 namespace arucoslam {
 
-bool KeyframePolicyOptions::Check() const {
-  return min_frames_between >= 0 && max_frames_between >= min_frames_between &&
-         tracked_ratio > 0.0 && tracked_ratio <= 1.0 && min_observations >= 1 &&
-         min_tracked_points >= 0 && weak_ratio >= 0.0 && weak_ratio <= tracked_ratio &&
-         weak_tracked_points >= 0 && weak_min_frames_between >= 1;
+bool KeyframePolicyOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.AtLeast("min_frames_between", min_frames_between, 0);
+  check.AtLeast("max_frames_between", max_frames_between, min_frames_between, "min_frames_between");
+  check.InRange("tracked_ratio", tracked_ratio, 0.0, 1.0, Interval::kOpenClosed);
+  check.AtLeast("min_observations", min_observations, 1);
+  check.AtLeast("min_tracked_points", min_tracked_points, 0);
+  check.AtLeast("weak_ratio", weak_ratio, 0.0);
+  check.AtMost("weak_ratio", weak_ratio, tracked_ratio, "tracked_ratio");
+  check.AtLeast("weak_tracked_points", weak_tracked_points, 0);
+  check.AtLeast("weak_min_frames_between", weak_min_frames_between, 1);
+  return check.ok();
 }
 
 KeyframeDecision DecideKeyframe(const KeyframePolicyOptions& options,

@@ -35,7 +35,7 @@ struct KeyframePolicyOptions {
   // keyframes too, and the scale drifted with the turn's low-parallax points.
   int weak_min_frames_between = 3;
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 // What the policy looks at for one tracked frame.

@@ -2,19 +2,32 @@
 
 #include <algorithm>
 
+#include "arucoslam/util/option_check.h"
 #include "arucoslam/util/timing.h"
 
 namespace arucoslam {
 
-bool LocalMapperOptions::Check() const {
-  return triangulation_neighbours >= 0 && min_baseline_depth_ratio >= 0.0 &&
-         max_match_distance >= 0 && match_ratio > 0.0 && match_ratio <= 1.0 &&
-         epipolar_chi2 > 0.0 && min_epipole_distance_px >= 0.0 && max_parallax_cos > 0.0 &&
-         max_parallax_cos < 1.0 && reprojection_chi2 > 0.0 && scale_consistency_factor >= 1.0 &&
-         fusion_neighbours >= 0 && fusion_radius_px > 0.0 && fusion_max_distance >= 0 &&
-         min_found_ratio >= 0.0 && min_found_ratio <= 1.0 && min_point_observations >= 1 &&
-         bundle_adjustment.Check() && redundant_fraction > 0.0 && redundant_fraction <= 1.0 &&
-         redundant_observers >= 1 && min_marker_keyframes >= 0;
+bool LocalMapperOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.AtLeast("triangulation_neighbours", triangulation_neighbours, 0);
+  check.AtLeast("min_baseline_depth_ratio", min_baseline_depth_ratio, 0.0);
+  check.AtLeast("max_match_distance", max_match_distance, 0);
+  check.InRange("match_ratio", match_ratio, 0.0, 1.0, Interval::kOpenClosed);
+  check.Above("epipolar_chi2", epipolar_chi2, 0.0);
+  check.AtLeast("min_epipole_distance_px", min_epipole_distance_px, 0.0);
+  check.InRange("max_parallax_cos", max_parallax_cos, 0.0, 1.0, Interval::kOpen);
+  check.Above("reprojection_chi2", reprojection_chi2, 0.0);
+  check.AtLeast("scale_consistency_factor", scale_consistency_factor, 1.0);
+  check.AtLeast("fusion_neighbours", fusion_neighbours, 0);
+  check.Above("fusion_radius_px", fusion_radius_px, 0.0);
+  check.AtLeast("fusion_max_distance", fusion_max_distance, 0);
+  check.InRange("min_found_ratio", min_found_ratio, 0.0, 1.0, Interval::kClosed);
+  check.AtLeast("min_point_observations", min_point_observations, 1);
+  check.Nested("bundle_adjustment", bundle_adjustment);
+  check.InRange("redundant_fraction", redundant_fraction, 0.0, 1.0, Interval::kOpenClosed);
+  check.AtLeast("redundant_observers", redundant_observers, 1);
+  check.AtLeast("min_marker_keyframes", min_marker_keyframes, 0);
+  return check.ok();
 }
 
 LocalMapper::LocalMapper(Map& map, const LocalMapperOptions& options)

@@ -4,7 +4,7 @@
 #pragma once
 
 #include <functional>
-
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -65,7 +65,7 @@ struct LocalMapperOptions {
   // by fewer than this many other keyframes (a marker's views hold its pose and the scale).
   int min_marker_keyframes = 3;
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 struct LocalMappingResult {

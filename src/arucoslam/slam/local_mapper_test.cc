@@ -109,6 +109,14 @@ TEST(LocalMapper, OptionsCheck) {
   LocalMapperOptions options;
   options.max_parallax_cos = 1.0;
   EXPECT_FALSE(options.Check());
+  options.max_parallax_cos = 1.2;
+  std::string why;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_EQ(why, "max_parallax_cos must be in (0, 1), is 1.2");
+  options = {};
+  options.bundle_adjustment.solver.max_iterations = 0;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_EQ(why, "bundle_adjustment.solver.max_iterations must be >= 1, is 0");
 }
 
 TEST(LocalMapper, TriangulatesNewPointsWithinBoundOfTruth) {

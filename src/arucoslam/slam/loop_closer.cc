@@ -6,6 +6,7 @@
 
 #include "arucoslam/feature/feature_grid.h"
 #include "arucoslam/slam/projection_queries.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 namespace {
@@ -168,11 +169,19 @@ std::vector<LoopConstraint> LoopConnections(
 
 }  // namespace
 
-bool LoopCloserOptions::Check() const {
-  return matching.Check() && sim3.Check() && loop_neighbours >= 0 && search_radius_px > 0.0 &&
-         max_projection_distance > 0 && reprojection_chi2 > 0.0 && min_total_matches >= 3 &&
-         max_correction_rotation_deg > 0.0 &&
-         correction_neighbours >= 0 && essential_graph.Check();
+bool LoopCloserOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.Nested("matching", matching);
+  check.Nested("sim3", sim3);
+  check.AtLeast("loop_neighbours", loop_neighbours, 0);
+  check.Above("search_radius_px", search_radius_px, 0.0);
+  check.Above("max_projection_distance", max_projection_distance, 0);
+  check.Above("reprojection_chi2", reprojection_chi2, 0.0);
+  check.AtLeast("min_total_matches", min_total_matches, 3);
+  check.Above("max_correction_rotation_deg", max_correction_rotation_deg, 0.0);
+  check.AtLeast("correction_neighbours", correction_neighbours, 0);
+  check.Nested("essential_graph", essential_graph);
+  return check.ok();
 }
 
 LoopCloser::LoopCloser(Map& map, const LoopCloserOptions& options) : map_(map), options_(options) {

@@ -38,7 +38,7 @@ struct LoopCloserOptions {
   // `sim3` and `essential_graph.solver`).
   bool metric_map = false;
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 struct LoopClosureResult {

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "arucoslam/util/option_check.h"
+
 namespace arucoslam {
 namespace {
 
@@ -35,10 +37,17 @@ double ReferenceScore(const MapData& data, const KeyframeDatabase& database, Key
 
 }  // namespace
 
-bool LoopDetectorOptions::Check() const {
-  return min_keyframes_in_map >= 0 && exclude_min_weight >= 1 && reference_min_weight >= 1 &&
-         min_score_ratio >= 0.0 && max_query_results >= 1 && grouping.Check() &&
-         min_consistent_keyframes >= 1 && max_marker_candidates >= 0;
+bool LoopDetectorOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.AtLeast("min_keyframes_in_map", min_keyframes_in_map, 0);
+  check.AtLeast("exclude_min_weight", exclude_min_weight, 1);
+  check.AtLeast("reference_min_weight", reference_min_weight, 1);
+  check.AtLeast("min_score_ratio", min_score_ratio, 0.0);
+  check.AtLeast("max_query_results", max_query_results, 1);
+  check.Nested("grouping", grouping);
+  check.AtLeast("min_consistent_keyframes", min_consistent_keyframes, 1);
+  check.AtLeast("max_marker_candidates", max_marker_candidates, 0);
+  return check.ok();
 }
 
 std::map<MarkerId, std::vector<KeyframeId>> BuildMarkerKeyframeIndex(const MapData& data) {

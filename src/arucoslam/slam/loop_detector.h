@@ -5,6 +5,7 @@
 #include <functional>
 #include <map>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "arucoslam/map/map.h"
@@ -32,7 +33,7 @@ struct LoopDetectorOptions {
   // Marker candidates: at most this many, those sharing most markers first.
   int max_marker_candidates = 3;
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 // Keyframes that saw a marker (any order); empty for an unknown marker.

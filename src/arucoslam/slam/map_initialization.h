@@ -2,10 +2,13 @@
 // and their map points, refines them by bundle adjustment and rescales to median depth 1.
 #pragma once
 
+#include <string>
+
 #include "arucoslam/map/frame.h"
 #include "arucoslam/map/map.h"
 #include "arucoslam/optim/bundle_adjustment.h"
 #include "arucoslam/slam/initializer.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -18,7 +21,12 @@ struct InitialMapOptions {
   // moves the points only.
   bool hold_motion = false;
 
-  bool Check() const { return bundle_adjustment.Check() && min_points >= 0; }
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.Nested("bundle_adjustment", bundle_adjustment);
+    check.AtLeast("min_points", min_points, 0);
+    return check.ok();
+  }
 };
 
 struct InitialMapResult {

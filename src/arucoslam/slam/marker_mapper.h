@@ -16,6 +16,7 @@
 #include "arucoslam/markers/marker_pose.h"
 #include "arucoslam/optim/essential_graph.h"
 #include "arucoslam/optim/marker_bundle_adjustment.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -56,13 +57,23 @@ struct MarkerMapperOptions {
   // mounting tilt estimated with them; GroundPlaneError). Local BA does not use it.
   std::optional<GroundPlanePriorOptions> ground_plane_prior;
 
-  bool Check() const {
-    return unknown_marker_size_m >= 0.0 && marker_pose.Check() && max_initial_rms_px > 0.0 &&
-           min_consistent_views >= 2 && max_view_disagreement_m > 0.0 &&
-           max_view_disagreement_fraction >= 0.0 && max_pending_views >= min_consistent_views &&
-           corner_sigma_px > 0.0 && min_corner_sigma_px > 0.0 &&
-           max_corner_sigma_px >= min_corner_sigma_px && bundle_adjustment.Check() &&
-           (!ground_plane_prior || ground_plane_prior->Check());
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.AtLeast("unknown_marker_size_m", unknown_marker_size_m, 0.0);
+    check.Nested("marker_pose", marker_pose);
+    check.Above("max_initial_rms_px", max_initial_rms_px, 0.0);
+    check.AtLeast("min_consistent_views", min_consistent_views, 2);
+    check.Above("max_view_disagreement_m", max_view_disagreement_m, 0.0);
+    check.AtLeast("max_view_disagreement_fraction", max_view_disagreement_fraction, 0.0);
+    check.AtLeast("max_pending_views", max_pending_views, min_consistent_views,
+                  "min_consistent_views");
+    check.Above("corner_sigma_px", corner_sigma_px, 0.0);
+    check.Above("min_corner_sigma_px", min_corner_sigma_px, 0.0);
+    check.AtLeast("max_corner_sigma_px", max_corner_sigma_px, min_corner_sigma_px,
+                  "min_corner_sigma_px");
+    check.Nested("bundle_adjustment", bundle_adjustment);
+    if (ground_plane_prior) check.Nested("ground_plane_prior", *ground_plane_prior);
+    return check.ok();
   }
 };
 

@@ -9,6 +9,7 @@
 
 #include "arucoslam/feature/feature_grid.h"
 #include "arucoslam/slam/projection_queries.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 namespace {
@@ -175,12 +176,23 @@ int SearchByProjection(const MapData& data, const std::vector<KeyframeId>& keyfr
 
 }  // namespace
 
-bool RelocalizerOptions::Check() const {
-  return max_query_results >= 1 && grouping.Check() && max_bow_distance >= 0 && bow_ratio > 0.0 &&
-         bow_ratio <= 1.0 && min_bow_matches >= 6 && pnp_threshold_px > 0.0 &&
-         pnp_iterations >= 1 && pnp_confidence > 0.0 && pnp_confidence < 1.0 &&
-         min_pnp_inliers >= 6 && pose.Check() && projection_neighbours >= 0 &&
-         wide_search.Check() && narrow_search.Check() && min_inliers >= 1;
+bool RelocalizerOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.AtLeast("max_query_results", max_query_results, 1);
+  check.Nested("grouping", grouping);
+  check.AtLeast("max_bow_distance", max_bow_distance, 0);
+  check.InRange("bow_ratio", bow_ratio, 0.0, 1.0, Interval::kOpenClosed);
+  check.AtLeast("min_bow_matches", min_bow_matches, 6);
+  check.Above("pnp_threshold_px", pnp_threshold_px, 0.0);
+  check.AtLeast("pnp_iterations", pnp_iterations, 1);
+  check.InRange("pnp_confidence", pnp_confidence, 0.0, 1.0, Interval::kOpen);
+  check.AtLeast("min_pnp_inliers", min_pnp_inliers, 6);
+  check.Nested("pose", pose);
+  check.AtLeast("projection_neighbours", projection_neighbours, 0);
+  check.Nested("wide_search", wide_search);
+  check.Nested("narrow_search", narrow_search);
+  check.AtLeast("min_inliers", min_inliers, 1);
+  return check.ok();
 }
 
 Relocalizer::Relocalizer(const Map& map, const KeyframeDatabase& database,

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "arucoslam/feature/orb_matcher.h"
@@ -39,7 +40,7 @@ struct RelocalizerOptions {
   // The frame is relocalised with at least this many inliers after the last optimisation.
   int min_inliers = 50;
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 struct RelocalizationResult {

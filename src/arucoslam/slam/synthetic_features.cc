@@ -2,11 +2,19 @@
 
 #include <algorithm>
 
+#include "arucoslam/util/option_check.h"
+
 namespace arucoslam {
 
-bool SyntheticFeatureOptions::Check() const {
-  return num_points >= 0 && (box_max - box_min).minCoeff() >= 0.0 && pixel_noise >= 0.0 &&
-         flipped_bits >= 0 && num_distractors >= 0 && border_px >= 0.0;
+bool SyntheticFeatureOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.AtLeast("num_points", num_points, 0);
+  check.Require((box_max - box_min).minCoeff() >= 0.0, "box_max", ">= box_min in every axis");
+  check.AtLeast("pixel_noise", pixel_noise, 0.0);
+  check.AtLeast("flipped_bits", flipped_bits, 0);
+  check.AtLeast("num_distractors", num_distractors, 0);
+  check.AtLeast("border_px", border_px, 0.0);
+  return check.ok();
 }
 
 SyntheticFeatureScene::SyntheticFeatureScene(const CameraModel& camera,

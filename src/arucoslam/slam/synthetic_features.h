@@ -3,9 +3,9 @@
 #pragma once
 
 #include <Eigen/Core>
-
 #include <cstdint>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "arucoslam/map/frame.h"
@@ -23,7 +23,7 @@ struct SyntheticFeatureOptions {
   double border_px = 20.0;    // points closer than this to the image border are not seen
   std::uint32_t seed = 1;
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 class SyntheticFeatureScene {

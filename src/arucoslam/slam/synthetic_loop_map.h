@@ -3,10 +3,12 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "arucoslam/map/map.h"
 #include "arucoslam/optim/synthetic_loop.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -18,7 +20,13 @@ struct SyntheticLoopMapOptions {
   int max_flipped_bits = 2;    // per observation, 0..max bits of the descriptor are flipped
   std::uint32_t seed = 11;
 
-  bool Check() const { return loop.Check() && num_wall_points > 0 && max_flipped_bits >= 0; }
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.Nested("loop", loop);
+    check.Above("num_wall_points", num_wall_points, 0);
+    check.AtLeast("max_flipped_bits", max_flipped_bits, 0);
+    return check.ok();
+  }
 };
 
 struct SyntheticLoopMap {

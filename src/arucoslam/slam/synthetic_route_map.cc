@@ -7,6 +7,8 @@
 #include <map>
 #include <stdexcept>
 
+#include "arucoslam/util/option_check.h"
+
 namespace arucoslam {
 namespace {
 
@@ -18,9 +20,14 @@ Eigen::Vector3d Outward(double azimuth_deg) {
 
 }  // namespace
 
-bool SyntheticRouteOptions::Check() const {
-  return num_wall_points > 0 && route_radius_m >= 0.0 && route_radius_m < 14.0 &&
-         pixel_noise >= 0.0 && max_flipped_bits >= 0 && keyframe_distractors >= 0;
+bool SyntheticRouteOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.Above("num_wall_points", num_wall_points, 0);
+  check.InRange("route_radius_m", route_radius_m, 0.0, 14.0, Interval::kClosedOpen);
+  check.AtLeast("pixel_noise", pixel_noise, 0.0);
+  check.AtLeast("max_flipped_bits", max_flipped_bits, 0);
+  check.AtLeast("keyframe_distractors", keyframe_distractors, 0);
+  return check.ok();
 }
 
 SyntheticRoute::SyntheticRoute(const SyntheticRouteOptions& options)

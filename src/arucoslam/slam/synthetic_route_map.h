@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <random>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -24,7 +25,7 @@ struct SyntheticRouteOptions {
   std::vector<std::pair<int, double>> markers;
   std::uint32_t seed = 5;
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 class SyntheticRoute {

@@ -10,6 +10,7 @@
 #include "arucoslam/feature/feature_grid.h"
 #include "arucoslam/slam/projection_queries.h"
 #include "arucoslam/util/logging.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 namespace {
@@ -36,16 +37,31 @@ std::string TrackingStateName(TrackingState state) {
   return "unknown";
 }
 
-bool TrackerOptions::Check() const {
-  return motion_search.Check() && min_motion_matches >= 0 && reference_search.Check() &&
-         min_reference_matches >= 0 && covisible_per_keyframe >= 0 && max_local_keyframes >= 1 &&
-         local_map_search.Check() && min_view_cos >= -1.0 && min_view_cos <= 1.0 &&
-         recovery_frames >= 0 && min_pose_inliers >= 3 && min_local_map_inliers >= min_pose_inliers &&
-         min_weak_inliers >= min_pose_inliers && min_weak_inliers <= min_local_map_inliers &&
-         weak_max_rotation_deg >= 0.0 && weak_max_center_steps >= 0.0 &&
-         weak_radius_factor >= 1.0 && pose.Check() &&
-         marker_pose.Check() && relocalization_min_axis_cos >= -1.0 &&
-         relocalization_min_axis_cos <= 1.0;
+bool TrackerOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.Nested("motion_search", motion_search);
+  check.AtLeast("min_motion_matches", min_motion_matches, 0);
+  check.Nested("reference_search", reference_search);
+  check.AtLeast("min_reference_matches", min_reference_matches, 0);
+  check.AtLeast("covisible_per_keyframe", covisible_per_keyframe, 0);
+  check.AtLeast("max_local_keyframes", max_local_keyframes, 1);
+  check.Nested("local_map_search", local_map_search);
+  check.InRange("min_view_cos", min_view_cos, -1.0, 1.0, Interval::kClosed);
+  check.AtLeast("recovery_frames", recovery_frames, 0);
+  check.AtLeast("min_pose_inliers", min_pose_inliers, 3);
+  check.AtLeast("min_local_map_inliers", min_local_map_inliers, min_pose_inliers,
+                "min_pose_inliers");
+  check.AtLeast("min_weak_inliers", min_weak_inliers, min_pose_inliers, "min_pose_inliers");
+  check.AtMost("min_weak_inliers", min_weak_inliers, min_local_map_inliers,
+               "min_local_map_inliers");
+  check.AtLeast("weak_max_rotation_deg", weak_max_rotation_deg, 0.0);
+  check.AtLeast("weak_max_center_steps", weak_max_center_steps, 0.0);
+  check.AtLeast("weak_radius_factor", weak_radius_factor, 1.0);
+  check.Nested("pose", pose);
+  check.Nested("marker_pose", marker_pose);
+  check.InRange("relocalization_min_axis_cos", relocalization_min_axis_cos, -1.0, 1.0,
+                Interval::kClosed);
+  return check.ok();
 }
 
 Tracker::Tracker(Map& map, const TrackerOptions& options) : map_(map), options_(options) {

@@ -65,7 +65,7 @@ struct TrackerOptions {
   // reads them). False for tracking that must leave the map untouched (initialisation backfill).
   bool update_point_statistics = true;
 
-  bool Check() const;
+  bool Check(std::string* why = nullptr) const;
 };
 
 struct TrackingResult {

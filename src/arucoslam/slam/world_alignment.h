@@ -10,6 +10,7 @@
 #include "arucoslam/map/ids.h"
 #include "arucoslam/map/map_data.h"
 #include "arucoslam/map/marker_landmark.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -40,9 +41,12 @@ struct WorldAlignmentOptions {
   // then comes from averaging the anchors' orientations instead of from the centres alone.
   double collinear_ratio = 0.05;
 
-  bool Check() const {
-    return ambiguous_weight >= 0.0 && ambiguous_weight <= 1.0 && outlier_threshold_m > 0.0 &&
-           collinear_ratio >= 0.0 && collinear_ratio < 1.0;
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.InRange("ambiguous_weight", ambiguous_weight, 0.0, 1.0, Interval::kClosed);
+    check.Above("outlier_threshold_m", outlier_threshold_m, 0.0);
+    check.InRange("collinear_ratio", collinear_ratio, 0.0, 1.0, Interval::kClosedOpen);
+    return check.ok();
   }
 };
 

@@ -4,9 +4,11 @@
 #pragma once
 
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "arucoslam/geometry/rigid3.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -18,9 +20,13 @@ struct WorldRotationVoteOptions {
   double min_margin = 2.0;
   int max_views = 150;  // the newest are kept
 
-  bool Check() const {
-    return agreement_deg > 0.0 && min_support >= 2 && min_margin > 1.0 &&
-           max_views >= min_support;
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.Above("agreement_deg", agreement_deg, 0.0);
+    check.AtLeast("min_support", min_support, 2);
+    check.Above("min_margin", min_margin, 1.0);
+    check.AtLeast("max_views", max_views, min_support, "min_support");
+    return check.ok();
   }
 };
 

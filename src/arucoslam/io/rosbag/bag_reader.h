@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "arucoslam/geometry/camera.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 
@@ -24,7 +25,11 @@ struct BagSourceOptions {
   // bag's camera_info, which may then be absent.
   std::filesystem::path camera_path;
 
-  bool Check() const { return !image_topic.empty(); }
+  bool Check(std::string* why = nullptr) const {
+    OptionCheck check(why);
+    check.Require(!image_topic.empty(), "image_topic", "non-empty");
+    return check.ok();
+  }
 };
 
 // The default camera_info topic of an image topic: "/cam/image_raw" -> "/cam/camera_info".
