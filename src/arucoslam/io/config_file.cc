@@ -308,10 +308,8 @@ void ConfigReader::ReadSection(const YAML::Node& node, const std::string& path, 
   }
   SectionVisitor fields(*this, path, entries);
   VisitOptions(options, fields);
-  if constexpr (requires(std::string * why) { options.Check(why); }) {
-    if (std::string why; !options.Check(&why)) {
-      FailCheck(path, node, fields.changes(), why, [&] { return options.Check(); });
-    }
+  if (std::string why; !options.Check(&why)) {
+    FailCheck(path, node, fields.changes(), why, [&] { return options.Check(); });
   }
 }
 
