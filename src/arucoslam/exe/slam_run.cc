@@ -52,6 +52,9 @@ SlamRunStats MakeStats(const std::string& dataset_label, const FrameSource& sour
   out.marker_fix_frames = stats.num_marker_frames;
   out.marker_disambiguations = stats.num_marker_disambiguations;
   out.map_rotation_disambiguations = stats.num_map_rotation_disambiguations;
+  out.covisible_disambiguations = stats.num_covisible_disambiguations;
+  out.relocated_marker_poses = stats.num_relocated_marker_poses;
+  out.late_marker_poses = stats.num_late_marker_poses;
   out.marker_only_poses = stats.num_marker_only_poses;
   out.world_alignments = stats.num_world_alignments;
   out.marker_drift_corrections = stats.num_marker_corrections;

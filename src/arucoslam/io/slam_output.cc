@@ -53,6 +53,9 @@ std::string FormatSlamStatsJson(const SlamRunStats& stats) {
         {"frames_with_fix", stats.marker_fix_frames},
         {"disambiguated_by_motion", stats.marker_disambiguations},
         {"disambiguated_by_map_rotation", stats.map_rotation_disambiguations},
+        {"disambiguated_by_covisible_markers", stats.covisible_disambiguations},
+        {"relocated_at_end", stats.relocated_marker_poses},
+        {"posed_at_end", stats.late_marker_poses},
         {"marker_only_poses", stats.marker_only_poses}};
     json["marker_fusion"] = {{"world_alignments", stats.world_alignments},
                              {"drift_corrections", stats.marker_drift_corrections},

@@ -44,6 +44,11 @@ struct SlamRunStats {
   int marker_fix_frames = 0;
   int marker_disambiguations = 0;
   int map_rotation_disambiguations = 0;  // ... of which by an unaligned map's voted orientation
+  int covisible_disambiguations = 0;     // ... of which by unknown markers seen with it
+  // At the end, with markers mapped: marker poses located again in the final marker map,
+  // and frames without a pose located in it.
+  int relocated_marker_poses = 0;
+  int late_marker_poses = 0;
   int marker_only_poses = 0;
   // ... and how the map was fused with them: world alignments, pose-graph drift
   // corrections, bundle adjustments of a whole map with every marker view, closed maps
@@ -69,6 +74,7 @@ std::string FormatPlyPoints(const std::vector<Eigen::Vector3d>& points);
 // "global_bundle_adjustments", "refined_frame_poses", "yielded_bundle_adjustments"}, with markers
 // "marker_locations":
 // {"frames_with_fix", "disambiguated_by_motion", "disambiguated_by_map_rotation",
+// "disambiguated_by_covisible_markers", "relocated_at_end", "posed_at_end",
 // "marker_only_poses"}, "marker_fusion": {"world_alignments", "drift_corrections",
 // "whole_map_adjustments", "map_merges", "rejected_keypoint_poses", "drift_beyond_gate"},
 // "timings_ms": {stage: {count, mean, median, p95, max}}, "wall_time_s", "peak_memory_bytes"}.

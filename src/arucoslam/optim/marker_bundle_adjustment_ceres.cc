@@ -270,7 +270,13 @@ MarkerBundleAdjustmentSummary SolveMarkerBundleAdjustment(
   const bool has_points = ordering->NumElements() > 0 && ordering->GroupSize(0) > 0;
   ceres_internal::SolveOptions solve_options =
       ceres_internal::BundleAdjustmentSolveOptions(options.solver);
-  solve_options.linear_solver_type = has_points ? ceres::DENSE_SCHUR : ceres::DENSE_QR;
+  // Without points: dense QR for a handful of blocks (one new marker), else the sparse
+  // normal equations (many marker views: dense QR grows with views^3).
+  constexpr int kMaxDenseBlocks = 16;
+  solve_options.linear_solver_type =
+      has_points ? ceres::DENSE_SCHUR
+      : ceres_problem.NumParameterBlocks() <= kMaxDenseBlocks ? ceres::DENSE_QR
+                                                               : ceres::SPARSE_NORMAL_CHOLESKY;
   if (has_points) solve_options.ordering = ordering;
   ceres_internal::Solve(solve_options, &ceres_problem, &summary);
   if (summary.success) blocks.CopyTo(problem);

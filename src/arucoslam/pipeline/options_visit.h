@@ -68,6 +68,11 @@ void VisitOptions(SystemOptions& o, Visitor& visit) {
         "unaligned map: ambiguous markers settled by the map's voted world orientation");
   visit("rotation_vote", o.rotation_vote, "that vote");
   visit("map_rotation_gates", o.map_rotation_gates, "gates of the voted orientation");
+  visit("resolve_ambiguity_by_covisible_markers", o.resolve_ambiguity_by_covisible_markers,
+        "else: ambiguous markers settled by the unknown markers seen with them");
+  visit("covisible_vote", o.covisible_vote, "that vote");
+  visit("relocate_marker_poses", o.relocate_marker_poses,
+        "at the end, with mapped markers: frames located again in the final marker map");
   visit("min_alignment_anchors", o.min_alignment_anchors,
         "world alignment waits for this many keyframes with a marker location");
   visit("min_alignment_baseline_m", o.min_alignment_baseline_m,

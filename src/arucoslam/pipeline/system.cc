@@ -58,6 +58,7 @@ bool SystemOptions::Check(std::string* why) const {
   check.AtLeast("min_marker_init_parallax_deg", min_marker_init_parallax_deg, 0.0);
   check.Nested("marker_search", marker_search);
   check.Nested("rotation_vote", rotation_vote);
+  check.Nested("covisible_vote", covisible_vote);
   check.Nested("map_rotation_gates", map_rotation_gates);
   check.InRange("refine_min_inlier_fraction", refine_min_inlier_fraction, 0.0, 1.0,
                 Interval::kOpenClosed);
@@ -126,6 +127,7 @@ void System::Finish() {
   StopMappingThread();
   if (places_) places_->Finish();
   FinishMarkerMapping();
+  RelocateMarkerPoses();
   RefineFramePoses();
   int num_inconsistent = 0;
   CheckedTrajectory(&num_inconsistent);
@@ -240,6 +242,13 @@ FrameReport System::ProcessFrame(Frame frame, const std::vector<MarkerDetection>
   // A loaded map that stays outside the marker world takes no marker-only poses.
   const bool marker_poses = world_aligned_ || !localize_only_;
   if (!report.cam_from_world && fix_ && marker_poses) RecordMarkerPose(frame, report);
+  if (!localize_only_) FeedMarkerView(frame);
+  // Without a world pose now (none, or a keypoint pose outside the world without a marker
+  // location), a frame that saw markers may be located at the end.
+  const bool world_pose = report.cam_from_world && (world_aligned_ || fix_);
+  if (!world_pose && !frame.markers.empty()) {
+    unposed_marker_frames_.push_back({frame.timestamp_s, frame.markers});
+  }
   report.world_aligned = world_aligned_;
   {
     std::lock_guard lock(stats_mutex_);
@@ -459,6 +468,10 @@ void System::RecordPose(const Frame& frame, KeyframeId reference) {
   pose.reference = reference;
   pose.cam_from_world = *frame.cam_from_world;
   pose.in_world = world_aligned_;
+  if (!world_aligned_ && fix_) {
+    pose.marker_cam_from_world = fix_->world_from_cam.Inverse();
+    pose.seen_markers = frame.markers;
+  }
   const std::optional<Rigid3> reference_pose = map_->Read([&](const MapData& data) {
     const Keyframe* keyframe = data.FindKeyframe(reference);
     return keyframe ? std::optional<Rigid3>(keyframe->cam_from_world) : std::nullopt;
@@ -489,6 +502,12 @@ void System::ResetMap() {
   std::vector<TrackedPose> kept;
   map_->Read([&](const MapData& data) {
     for (TrackedPose pose : poses_) {
+      if (!pose.in_world && pose.marker_cam_from_world) {  // frozen at its marker location
+        pose.cam_from_world = *pose.marker_cam_from_world;
+        pose.cam_from_reference = pose.cam_from_world;
+        pose.reference = KeyframeId();
+        pose.in_world = true;
+      }
       if (!pose.in_world) continue;
       if (kept_for_merge) pose.closed_reference = KeyframeId();  // an older closed map's
       if (const Keyframe* reference = data.FindKeyframe(pose.reference)) {
@@ -528,6 +547,7 @@ void System::ResetMap() {
   next_alignment_anchors_ = 0;
   world_aligned_ = false;
   rotation_vote_.Clear();
+  covisible_vote_.Clear();
   absorbed_keyframes_.clear();
   bridge_priors_.clear();
   bridge_adjustment_priors_.clear();
@@ -558,7 +578,12 @@ std::vector<StampedPose> System::CurrentMapPoses(bool world_only) const {
   std::vector<StampedPose> trajectory;
   map_->Read([&](const MapData& data) {
     for (const TrackedPose& pose : poses_) {
-      if (world_only && !pose.in_world) continue;
+      if (world_only && !pose.in_world) {
+        if (pose.marker_cam_from_world) {
+          trajectory.push_back({pose.timestamp_s, pose.marker_cam_from_world->Inverse()});
+        }
+        continue;
+      }
       const Keyframe* reference = data.FindKeyframe(pose.reference);
       const Rigid3 cam_from_world =
           reference ? PoseFromReference(pose, reference->cam_from_world) : pose.cam_from_world;

@@ -37,6 +37,7 @@
 #include "arucoslam/slam/marker_mapper.h"
 #include "arucoslam/slam/tracker.h"
 #include "arucoslam/slam/world_alignment.h"
+#include "arucoslam/slam/covisible_marker_vote.h"
 #include "arucoslam/slam/world_rotation_vote.h"
 #include "arucoslam/util/timing.h"
 
@@ -118,6 +119,13 @@ struct SystemOptions {
   bool resolve_ambiguity_by_map_rotation = true;
   WorldRotationVoteOptions rotation_vote;
   AmbiguityPriorGates map_rotation_gates{.max_rotation_deg = 6.0};
+  // Else the markers the known map lacks, seen with the ambiguous one, vote: only the true
+  // camera poses of two viewpoints put them at the same world points (covisible_marker_vote.h).
+  bool resolve_ambiguity_by_covisible_markers = true;
+  // At Finish, when markers were mapped: frames posed by markers are located again in the
+  // final marker map, and frames that saw markers but got no pose are located in it.
+  bool relocate_marker_poses = true;
+  CovisibleMarkerVoteOptions covisible_vote;
   // World alignment waits for this many keyframes with a usable marker location whose
   // camera centres span at least min_alignment_baseline_m (metres); it is refused when the
   // anchors' residual after alignment exceeds max_alignment_rms_m (metres).
@@ -306,6 +314,9 @@ struct SystemStats {
   int num_full_marker_scans = 0;  // frames whose markers were searched in the whole image
   int num_marker_frames = 0;      // frames with a usable marker location
   int num_marker_disambiguations = 0;  // ... of which one ambiguous marker settled by motion
+  int num_relocated_marker_poses = 0;  // marker poses located again in the final marker map
+  int num_late_marker_poses = 0;       // frames without a pose located in it at the end
+  int num_covisible_disambiguations = 0;  // ... by markers seen with it (CovisibleMarkerVote)
   int num_map_rotation_disambiguations = 0;  // ... by the unaligned map's voted orientation
   int num_marker_only_poses = 0;  // frames whose pose came from markers alone
   int num_world_alignments = 0;
@@ -388,6 +399,15 @@ class System {
     // What tracking matched in the frame (refine_frame_poses; emptied at Finish).
     std::vector<FrameMatch> matches;
     std::vector<MarkerPoseObservation> markers;  // known markers only
+    // The frame's marker location while its map is not in the world: its pose if the map
+    // never gets there.
+    std::optional<Rigid3> marker_cam_from_world;
+    // The markers a frame posed by markers saw (RelocateMarkerPoses).
+    std::vector<MarkerObservation> seen_markers;
+  };
+  struct UnposedMarkerFrame {  // a frame that saw markers but got no pose
+    double timestamp_s = 0.0;
+    std::vector<MarkerObservation> markers;
   };
   struct MarkerAnchor {
     KeyframeId keyframe;
@@ -410,6 +430,22 @@ class System {
   bool RelocalizeWithMarkers(Frame& frame, FrameReport& report);
   // The solution of an ambiguous one-marker location that the motion predictions settle on.
   // `by_map_rotation`: settled by the unaligned map's voted orientation alone.
+  // The detections of markers absent from the locating map, and their side (metres).
+  // Whether a found location (its IPPE alternative when `alternative`) fits its corners
+  // within max_marker_rms_px with its nearest marker within max_marker_distance_sides
+  // (returned in `nearest_sides`).
+  bool UsableLocation(const CameraLocation& location, bool alternative, const MarkerMap& known,
+                      double* nearest_sides) const;
+  // Finish, when markers were mapped: the frames posed by markers are located again in the
+  // final marker map, and the frames that saw markers but got no pose are located in it
+  // (system_marker_relocation.cc).
+  void RelocateMarkerPoses();
+  std::optional<Rigid3> LocateInFinalMap(const std::vector<MarkerObservation>& markers,
+                                         const MarkerMap& final_map,
+                                         const std::optional<Rigid3>& previous) const;
+  std::vector<MarkerDetection> UnknownDetections(
+      const CameraLocation& location, const std::vector<MarkerDetection>& detections) const;
+  double UnknownMarkerSize() const;
   AmbiguityChoice ResolveByMotion(const CameraLocation& location, double timestamp_s,
                                   bool* by_map_rotation) const;
   // The frame's marker location minus the camera centre of `cam_from_world` (needs fix_).
@@ -459,6 +495,10 @@ class System {
   // after the map was replaced. Finish: final marker refinement.
   void StartMarkerMapping();
   void FeedMarkerMapping(KeyframeId keyframe);
+  // Tracking thread, while no map is in the world: a frame posed by markers maps unknown
+  // markers as a marker view (MarkerMapper::AddMarkerView).
+  void FeedMarkerView(const Frame& frame);
+  MarkerMapper& EnsureMarkerMapper();
   int ResetMarkerMapping();  // the closed map's marker generation (-1: no mapper)
   void FinishMarkerMapping();
   // Bundle adjustment of the whole world-aligned map with every marker view (`when` is for
@@ -540,6 +580,7 @@ class System {
   // Unaligned map: the orientation votes of its ambiguous marker views, and the current
   // frame's ambiguous location (voted once the frame is tracked).
   WorldRotationVote rotation_vote_{options_.rotation_vote};
+  CovisibleMarkerVote covisible_vote_{options_.covisible_vote};
   std::optional<CameraLocation> ambiguous_location_;
   void VoteForWorldRotation(const Frame& frame);
   std::vector<MarkerAnchor> anchors_;
@@ -601,6 +642,8 @@ class System {
   double marker_wait_ms_ = 0.0;  // the current image's wait for its detections
   // Markers of the world-aligned map; only the mapping thread touches it while it runs.
   std::unique_ptr<MarkerMapper> marker_mapper_;
+  std::vector<UnposedMarkerFrame> unposed_marker_frames_;
+  int marker_views_refined_ = 0;  // marker views at the last refinement (FeedMarkerView)
   bool marker_mapping_live_ = false;  // the current map is aligned and feeds marker_mapper_
   // Known + mapped markers that locate frames, published by the mapping thread.
   mutable std::mutex locating_mutex_;

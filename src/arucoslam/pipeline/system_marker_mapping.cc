@@ -12,13 +12,18 @@
 
 namespace arucoslam {
 
-void System::StartMarkerMapping() {
-  if (!options_.marker_map) return;
+MarkerMapper& System::EnsureMarkerMapper() {
   if (!marker_mapper_) {
     MarkerMapperOptions mapping = options_.marker_mapping;
     mapping.map_unknown = mapping.map_unknown && options_.map_unknown_markers;
     marker_mapper_ = std::make_unique<MarkerMapper>(*options_.marker_map, mapping);
   }
+  return *marker_mapper_;
+}
+
+void System::StartMarkerMapping() {
+  if (!options_.marker_map) return;
+  EnsureMarkerMapper();
   marker_mapping_live_ = true;
   if (options_.markers_in_local_ba) {
     mapper_->SetMarkerLandmarks(marker_mapper_->mutable_landmarks());
@@ -62,13 +67,39 @@ void System::FeedMarkerMapping(KeyframeId keyframe) {
   PublishLocatingMarkers();
 }
 
+void System::FeedMarkerView(const Frame& frame) {
+  if (!fix_ || marker_mapping_live_ || !options_.map_unknown_markers ||
+      !options_.marker_mapping.marker_views || frame.markers.empty()) {
+    return;
+  }
+  std::vector<MarkerId> initialised;
+  const bool taken = EnsureMarkerMapper().AddMarkerView(fix_->world_from_cam.Inverse(),
+                                                        frame.camera, frame.markers,
+                                                        &initialised);
+  if (!taken) return;
+  for (const MarkerId& id : initialised) {
+    ARUCOSLAM_LOG_DEBUG("frame at t {:.3f}: marker {} mapped from marker views",
+                        frame.timestamp_s, id.value);
+  }
+  // The mapped markers and the views are adjusted together as the views grow by a fifth
+  // (and when a marker is mapped), so that frames are located against settled markers.
+  const int views = marker_mapper_->NumMarkerViews();
+  if (!initialised.empty() || views >= 1.2 * marker_views_refined_ + 1) {
+    const MarkerBundleAdjustmentSummary summary = marker_mapper_->RefineMarkers();
+    marker_views_refined_ = views;
+    ARUCOSLAM_LOG_DEBUG("{} marker views: mapped markers refined: {}", views,
+                        summary.BriefReport());
+  }
+  PublishLocatingMarkers();
+}
+
 void System::PublishLocatingMarkers() {
   if (options_.min_locating_marker_keyframes <= 0) return;
   MarkerMap locating = *options_.marker_map;
   bool any = false;
   for (const auto& [id, landmark] : marker_mapper_->landmarks().landmarks()) {
     if (landmark.fixed || locating.markers.count(id.value) != 0 ||
-        static_cast<int>(landmark.observations.size()) < options_.min_locating_marker_keyframes) {
+        marker_mapper_->NumViews(id) < options_.min_locating_marker_keyframes) {
       continue;
     }
     locating.markers[id.value] = landmark.ToMarkerInfo();

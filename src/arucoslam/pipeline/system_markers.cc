@@ -82,23 +82,25 @@ std::optional<System::MarkerFix> System::LocateWithMarkers(
   report.num_markers = static_cast<int>(location.marker_ids.size());
   std::optional<MarkerFix> fix;
   // An ambiguous location counts only as the solution the motion prediction settles on.
-  bool by_map_rotation = false;
-  const AmbiguityChoice choice =
+  bool by_map_rotation = false, by_covisible = false;
+  AmbiguityChoice choice =
       location.found && location.quality.ambiguous && options_.resolve_ambiguity_by_motion
           ? ResolveByMotion(location, frame.timestamp_s, &by_map_rotation)
           : AmbiguityChoice::kNone;
+  if (choice == AmbiguityChoice::kNone && location.found && location.quality.ambiguous &&
+      options_.resolve_ambiguity_by_covisible_markers) {
+    choice = covisible_vote_.Add(location, UnknownDetections(location, detections),
+                                 UnknownMarkerSize(), frame.camera);
+    by_covisible = choice != AmbiguityChoice::kNone;
+  }
   ambiguous_location_.reset();
   const bool resolved = choice != AmbiguityChoice::kNone;
   const bool alternative = choice == AmbiguityChoice::kAlternative;
   const Rigid3 world_from_cam =
       resolved ? *ChosenPose(location, choice) : location.world_from_cam;
-  const double rms_px = alternative ? location.quality.alternative_rms_px
-                                    : location.quality.reprojection_rms_px;
-  const double nearest_sides = location.found
-                                   ? NearestMarkerInSides(location, world_from_cam, known)
-                                   : std::numeric_limits<double>::infinity();
+  double nearest_sides = std::numeric_limits<double>::infinity();
   const bool usable =
-      rms_px <= options_.max_marker_rms_px && nearest_sides <= options_.max_marker_distance_sides;
+      location.found && UsableLocation(location, alternative, known, &nearest_sides);
   if (location.found && location.quality.ambiguous && location.alternative_world_from_cam &&
       usable && !world_aligned_ && options_.resolve_ambiguity_by_map_rotation) {
     ambiguous_location_ = location;  // votes for the map's orientation once tracked
@@ -140,12 +142,44 @@ std::optional<System::MarkerFix> System::LocateWithMarkers(
     if (fix->disambiguated_by_motion) {
       ++stats_.num_marker_disambiguations;
       if (by_map_rotation) ++stats_.num_map_rotation_disambiguations;
+      if (by_covisible) ++stats_.num_covisible_disambiguations;
       ARUCOSLAM_LOG_DEBUG("frame {}: ambiguous marker {} settled by the motion prediction{}",
                           report.index, location.marker_ids.front(),
                           alternative ? " (IPPE's second solution)" : "");
     }
   }
   return fix;
+}
+
+std::vector<MarkerDetection> System::UnknownDetections(
+    const CameraLocation& location, const std::vector<MarkerDetection>& detections) const {
+  std::vector<MarkerDetection> unknown;
+  for (const MarkerDetection& detection : detections) {
+    if (std::binary_search(location.unknown_marker_ids.begin(), location.unknown_marker_ids.end(),
+                           detection.id)) {
+      unknown.push_back(detection);
+    }
+  }
+  return unknown;
+}
+
+double System::UnknownMarkerSize() const {
+  if (options_.marker_mapping.unknown_marker_size_m > 0.0) {
+    return options_.marker_mapping.unknown_marker_size_m;
+  }
+  const MarkerMap& known = *options_.marker_map;
+  return known.markers.empty() ? 0.0 : known.markers.begin()->second.size;
+}
+
+bool System::UsableLocation(const CameraLocation& location, bool alternative,
+                            const MarkerMap& known, double* nearest_sides) const {
+  const double rms_px = alternative ? location.quality.alternative_rms_px
+                                    : location.quality.reprojection_rms_px;
+  const Rigid3& world_from_cam =
+      alternative ? *location.alternative_world_from_cam : location.world_from_cam;
+  *nearest_sides = NearestMarkerInSides(location, world_from_cam, known);
+  return rms_px <= options_.max_marker_rms_px &&
+         *nearest_sides <= options_.max_marker_distance_sides;
 }
 
 AmbiguityChoice System::ResolveByMotion(const CameraLocation& location, double timestamp_s,
@@ -393,6 +427,7 @@ void System::RecordMarkerPose(const Frame& frame, FrameReport& report) {
   pose.cam_from_reference = cam_from_world;
   pose.cam_from_world = cam_from_world;
   pose.in_world = true;
+  pose.seen_markers = frame.markers;
   poses_.push_back(pose);
   std::lock_guard lock(stats_mutex_);
   ++stats_.num_marker_only_poses;

@@ -42,6 +42,60 @@ std::vector<MarkerId> MarkerMapper::AddKeyframe(KeyframeId keyframe, const Rigid
   return initialised;
 }
 
+bool MarkerMapper::WantsMarkerView(const Rigid3& cam_from_world,
+                                   const std::vector<MarkerObservation>& markers) const {
+  const Eigen::Vector3d centre = cam_from_world.Inverse().translation;
+  bool maps_something = false;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const MarkerObservation& observation : markers) {
+    const MarkerLandmark* landmark = landmarks_.Find(observation.marker_id);
+    if (landmark == nullptr || !landmark->fixed) maps_something = true;
+    if (landmark != nullptr) {
+      nearest = std::min(nearest, (landmark->world_from_marker.translation - centre).norm());
+    }
+  }
+  if (!maps_something || !std::isfinite(nearest)) return false;
+  const double min_translation = options_.marker_view_min_translation_fraction * nearest;
+  const double min_rotation = options_.marker_view_min_rotation_deg * M_PI / 180.0;
+  for (const auto& [index, record] : records_) {
+    if (record.generation != kMarkerViewGeneration) continue;
+    const bool near =
+        (record.cam_from_world.Inverse().translation - centre).norm() < min_translation;
+    const bool turned =
+        RotationAngle(record.cam_from_world.rotation * cam_from_world.rotation.inverse()) >=
+        min_rotation;
+    if (near && !turned) return false;
+  }
+  return true;
+}
+
+bool MarkerMapper::AddMarkerView(const Rigid3& cam_from_world, const CameraModel& camera,
+                                 const std::vector<MarkerObservation>& markers,
+                                 std::vector<MarkerId>* initialised) {
+  if (!WantsMarkerView(cam_from_world, markers)) return false;
+  const int record = next_record_++;
+  records_[record] = {KeyframeId(), kMarkerViewGeneration, cam_from_world, camera, markers};
+  ++num_marker_views_;
+  for (const MarkerObservation& observation : markers) {
+    if (!landmarks_.Contains(observation.marker_id) && unknown_size_ > 0.0) {
+      Observe(record, observation, initialised);
+    }
+  }
+  return true;
+}
+
+int MarkerMapper::NumViews(MarkerId id) const {
+  const MarkerLandmark* landmark = landmarks_.Find(id);
+  int count = landmark != nullptr ? static_cast<int>(landmark->observations.size()) : 0;
+  for (const auto& [index, record] : records_) {
+    if (record.keyframe.IsValid()) continue;
+    for (const MarkerObservation& observation : record.markers) {
+      if (observation.marker_id == id) ++count;
+    }
+  }
+  return count;
+}
+
 void MarkerMapper::EraseKeyframe(KeyframeId keyframe) {
   landmarks_.EraseKeyframe(keyframe);
   const auto found = live_.find(keyframe);

@@ -42,6 +42,14 @@ struct MarkerMapperOptions {
   double max_view_disagreement_fraction = 0.03;
   // Views an unmapped marker keeps (the oldest are dropped first).
   int max_pending_views = 30;
+  // Marker views (AddMarkerView): frames posed by markers alone map unknown markers too, so
+  // a marker map grows before (or without) a keypoint map in the world. A frame is taken
+  // when its
+  // camera centre lies at least this fraction of its distance to the nearest located marker
+  // from every view taken, or its orientation this many degrees from theirs.
+  bool marker_views = true;
+  double marker_view_min_translation_fraction = 0.05;
+  double marker_view_min_rotation_deg = 5.0;
   // Corner noise given to the bundle adjustment, pixels.
   double corner_sigma_px = 1.0;
   // Refine with the map: after a first solve with corner_sigma_px, the corner sigma is
@@ -67,6 +75,9 @@ struct MarkerMapperOptions {
     check.AtLeast("max_view_disagreement_fraction", max_view_disagreement_fraction, 0.0);
     check.AtLeast("max_pending_views", max_pending_views, min_consistent_views,
                   "min_consistent_views");
+    check.AtLeast("marker_view_min_translation_fraction", marker_view_min_translation_fraction,
+                  0.0);
+    check.AtLeast("marker_view_min_rotation_deg", marker_view_min_rotation_deg, 0.0);
     check.Above("corner_sigma_px", corner_sigma_px, 0.0);
     check.Above("min_corner_sigma_px", min_corner_sigma_px, 0.0);
     check.AtLeast("max_corner_sigma_px", max_corner_sigma_px, min_corner_sigma_px,
@@ -87,6 +98,18 @@ class MarkerMapper {
   std::vector<MarkerId> AddKeyframe(KeyframeId keyframe, const Rigid3& cam_from_world,
                                     const CameraModel& camera,
                                     const std::vector<MarkerObservation>& markers);
+  // A frame posed in the world by markers alone (no keypoint map in the world to give
+  // keyframes): taken as a view when it sees a marker the known map lacks or holds as not
+  // fixed and lies away from the views taken (marker_view_* options). Its pose stays in the
+  // world (no similarity moves it); it maps unknown markers like a keyframe, and joins
+  // RefineMarkers and Refine. Returns whether it was taken; `initialised` gets the markers
+  // it mapped.
+  bool AddMarkerView(const Rigid3& cam_from_world, const CameraModel& camera,
+                     const std::vector<MarkerObservation>& markers,
+                     std::vector<MarkerId>* initialised);
+  int NumMarkerViews() const { return num_marker_views_; }
+  // Keyframes and retired records (marker views too) that saw marker `id`.
+  int NumViews(MarkerId id) const;
   // Forgets a keyframe and every marker view it gave.
   void EraseKeyframe(KeyframeId keyframe);
   // Takes the current pose of every recorded keyframe from `map` (optimisation moved them);
@@ -114,8 +137,10 @@ class MarkerMapper {
   void SetPositionPriors(std::vector<KeyframePosePrior> priors) {
     position_priors_ = std::move(priors);
   }
-  // Refines only the mapped markers against the recorded keyframe poses, live and retired
-  // (held fixed).
+  // Refines the mapped markers against the recorded keyframe poses, live and retired (held
+  // fixed), and the marker views that see two markers or more (estimated with them; the
+  // refined poses are kept). First every mapped marker whose views another orientation
+  // explains clearly better (ReconsiderMappedMarkers) is moved to it.
   MarkerBundleAdjustmentSummary RefineMarkers();
 
   const MarkerLandmarks& landmarks() const { return landmarks_; }
@@ -137,6 +162,12 @@ class MarkerMapper {
     std::vector<MarkerObservation> markers;
     KeyframeId closed_as = KeyframeId();  // the keyframe CloseMap retired it from
   };
+  // The generation of marker views: in the world from the start, no map's similarity or
+  // merge applies to them.
+  static constexpr int kMarkerViewGeneration = -1;
+  // Whether a frame at `cam_from_world` seeing `markers` adds a new marker view.
+  bool WantsMarkerView(const Rigid3& cam_from_world,
+                       const std::vector<MarkerObservation>& markers) const;
   struct View {
     int record = 0;  // into records_
     std::array<Eigen::Vector2d, 4> corners_px;
@@ -153,6 +184,11 @@ class MarkerMapper {
                                          const Rigid3& world_from_marker) const;
   double ViewsSquaredError(const std::vector<const View*>& views,
                            const Rigid3& world_from_marker) const;
+  // A mapped marker initialised from few or similar views may sit in the wrong IPPE branch;
+  // with more views recorded, each view's solutions are candidates and one whose views'
+  // corner error (each view's capped) is under half the current one replaces it. Returns
+  // how many moved.
+  int ReconsiderMappedMarkers();
   // Bundle adjustment of one new marker against its views' poses (fixed).
   Rigid3 RefineNewMarker(const Rigid3& initial, const std::vector<const View*>& views) const;
   // What each pose, point and marker of a built problem is: the live keyframes' poses come
@@ -164,7 +200,8 @@ class MarkerMapper {
     std::vector<MarkerId> markers;
   };
   // With `map`: its keyframes and points, free, and the retired views that see two markers
-  // or more (free poses). Without: the recorded poses, live and retired, fixed.
+  // or more (free poses). Without: the recorded poses, live and retired, fixed, but the
+  // marker views that see two markers or more (free).
   MarkerBundleAdjustmentProblem BuildProblem(const MapData* map, ProblemIndex* index) const;
 
   MarkerMapperOptions options_;
@@ -176,6 +213,7 @@ class MarkerMapper {
   std::map<KeyframeId, int> live_;         // live keyframe -> its record
   int next_record_ = 0;
   int generation_ = 0;
+  int num_marker_views_ = 0;
   std::map<MarkerId, std::vector<View>> pending_;
 };
 

@@ -1,10 +1,12 @@
 // MarkerMapper's bundle adjustments: one new marker against its views, the mapped markers
 // against the recorded poses, and the whole map with every marker view (retired ones too).
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <optional>
 #include <utility>
 
+#include "arucoslam/markers/marker_pose.h"
 #include "arucoslam/optim/marker_factors.h"
 #include "arucoslam/slam/marker_mapper.h"
 
@@ -89,7 +91,9 @@ MarkerBundleAdjustmentProblem MarkerMapper::BuildProblem(const MapData* map,
       sees_mapped = sees_mapped || !landmark->fixed;
     }
     if (seen.size() < min_markers || !sees_mapped) continue;
-    const std::size_t pose = add_pose(record.cam_from_world, record.camera, map == nullptr);
+    const bool free_view = map != nullptr || (record.generation == kMarkerViewGeneration &&
+                                              seen.size() >= 2);
+    const std::size_t pose = add_pose(record.cam_from_world, record.camera, !free_view);
     index->retired.push_back(id);
     for (const MarkerObservation* observation : seen) {
       retired_views[observation->marker_id].push_back({pose, observation});
@@ -169,12 +173,75 @@ MarkerBundleAdjustmentSummary MarkerMapper::Refine(MapData* map) {
   return summary;
 }
 
+int MarkerMapper::ReconsiderMappedMarkers() {
+  constexpr double kCapPx = 5.0;        // a view's RMS counts at most this much
+  constexpr int kMaxCandidateViews = 12;  // views whose IPPE solutions are tried
+  struct SeenBy {
+    const Record* record;
+    const std::array<Eigen::Vector2d, 4>* corners_px;
+  };
+  int moved = 0;
+  for (const auto& [id, landmark] : landmarks_.landmarks()) {
+    if (landmark.fixed) continue;
+    std::vector<SeenBy> views;
+    for (const auto& [index, record] : records_) {
+      for (const MarkerObservation& observation : record.markers) {
+        if (observation.marker_id == id) views.push_back({&record, &observation.corners_px});
+      }
+    }
+    if (views.size() < 2) continue;
+    const std::array<Eigen::Vector3d, 4> corners = SquareCorners(landmark.size);
+    const auto error = [&](const Rigid3& world_from_marker) {
+      double sum = 0.0;
+      for (const SeenBy& view : views) {
+        const double rms = MarkerReprojectionRms(
+            view.record->camera, view.record->cam_from_world * world_from_marker, corners,
+            *view.corners_px);
+        sum += std::min(rms * rms, kCapPx * kCapPx);
+      }
+      return sum;
+    };
+    const double current = error(landmark.world_from_marker);
+    double best_error = current;
+    std::optional<Rigid3> best;
+    const std::size_t step = std::max<std::size_t>(1, views.size() / kMaxCandidateViews);
+    for (std::size_t v = 0; v < views.size(); v += step) {
+      MarkerDetection detection;
+      detection.id = id.value;
+      detection.corners = *views[v].corners_px;
+      const std::optional<MarkerPose> pose =
+          EstimateMarkerPose(detection, landmark.size, views[v].record->camera,
+                             options_.marker_pose);
+      if (!pose) continue;
+      const Rigid3 world_from_cam = views[v].record->cam_from_world.Inverse();
+      for (int s = 0; s < pose->num_solutions; ++s) {
+        const Rigid3 candidate = world_from_cam * pose->solutions[s].cam_from_marker;
+        const double candidate_error = error(candidate);
+        if (candidate_error < best_error) {
+          best_error = candidate_error;
+          best = candidate;
+        }
+      }
+    }
+    if (best && best_error < 0.5 * current) {
+      landmarks_.SetPose(id, *best);
+      ++moved;
+    }
+  }
+  return moved;
+}
+
 MarkerBundleAdjustmentSummary MarkerMapper::RefineMarkers() {
+  ReconsiderMappedMarkers();
   ProblemIndex index;
   MarkerBundleAdjustmentProblem problem = BuildProblem(nullptr, &index);
   const MarkerBundleAdjustmentSummary summary =
       SolveMarkerBundleAdjustment(options_.bundle_adjustment, &problem);
   if (!summary.success) return summary;
+  for (std::size_t i = 0; i < index.retired.size(); ++i) {
+    records_.at(index.retired[i]).cam_from_world =
+        problem.keypoints.poses[index.keyframes.size() + i].cam_from_world;  // fixed or view
+  }
   for (std::size_t i = 0; i < index.markers.size(); ++i) {
     landmarks_.SetPose(index.markers[i], problem.markers[i].world_from_marker);
   }

@@ -287,6 +287,73 @@ TEST(MarkerMapperTest, RefineMarkersAloneFitsTheRecordedPoses) {
   }
 }
 
+// Frames posed by markers alone (no keypoint map): their views map the unknown markers, a
+// frame where one was taken already adds nothing, and the adjustment of markers and views
+// brings the markers closer.
+TEST(MarkerMapperTest, MarkerViewsMapUnknownMarkersWithoutKeyframes) {
+  MappedScene scene;
+  Build(scene, Sim3(), 0.003);  // view poses a few millimetres off, as located by markers
+  MarkerMapper mapper(KnownMap(scene.truth));
+  std::vector<MarkerId> initialised;
+  int taken = 0;
+  for (std::size_t i = 0; i < scene.keyframes.size(); ++i) {
+    const Rigid3& pose = scene.map.FindKeyframe(scene.keyframes[i])->cam_from_world;
+    if (mapper.AddMarkerView(pose, scene.camera, scene.markers[i], &initialised)) ++taken;
+    // The same place again is not a new view.
+    EXPECT_FALSE(mapper.AddMarkerView(pose, scene.camera, scene.markers[i], &initialised));
+  }
+  EXPECT_GT(taken, static_cast<int>(scene.keyframes.size()) / 2);
+  EXPECT_EQ(mapper.NumMarkerViews(), taken);
+  EXPECT_EQ(initialised.size() + 1, scene.truth.markers.size());
+  ASSERT_EQ(mapper.landmarks().size(), scene.truth.markers.size());
+  for (const auto& [id, landmark] : mapper.landmarks().landmarks()) {
+    EXPECT_TRUE(landmark.observations.empty());  // no keyframe saw it
+    EXPECT_GE(mapper.NumViews(id), 2) << "marker " << id.value;
+  }
+  double worst_initial = 0.0;
+  for (const auto& [id, landmark] : mapper.landmarks().landmarks()) {
+    worst_initial = std::max(worst_initial, PositionError(landmark, scene.truth));
+  }
+  const auto summary = mapper.RefineMarkers();
+  ASSERT_TRUE(summary.success) << summary.message;
+  double worst = 0.0;
+  for (const auto& [id, landmark] : mapper.landmarks().landmarks()) {
+    worst = std::max(worst, PositionError(landmark, scene.truth));
+  }
+  std::printf("markers mapped from marker views: worst %.4f m, %.4f m before the refinement\n",
+              worst, worst_initial);
+  // Markers up to 10 m away seen from poses a few millimetres and milliradians off.
+  EXPECT_LT(worst, 0.05);
+  EXPECT_LT(worst, 0.7 * worst_initial);  // all views together beat the first ones
+  // A frame that sees only fixed markers maps nothing: it is not taken.
+  MarkerMapper all_known(KnownMap(scene.truth, scene.truth.markers.size()));
+  EXPECT_FALSE(all_known.AddMarkerView(scene.map.FindKeyframe(scene.keyframes[0])->cam_from_world,
+                                       scene.camera, scene.markers[0], &initialised));
+}
+
+// A mapped marker left in the wrong orientation (a wrong IPPE branch) is turned back by
+// RefineMarkers once its views explain another orientation clearly better.
+TEST(MarkerMapperTest, RefineMarkersTurnsAMarkerOutOfAWrongOrientation) {
+  MappedScene scene;
+  Build(scene, Sim3(), 0.0);
+  MarkerMapper mapper(KnownMap(scene.truth));
+  AddAll(scene, mapper);
+  const MarkerId wrong(1);
+  const MarkerLandmark* landmark = mapper.landmarks().Find(wrong);
+  ASSERT_NE(landmark, nullptr);
+  const Rigid3 turned(
+      landmark->world_from_marker.rotation *
+          Eigen::Quaterniond(Eigen::AngleAxisd(1.2, Eigen::Vector3d::UnitX())),
+      landmark->world_from_marker.translation);
+  mapper.mutable_landmarks()->SetPose(wrong, turned);
+  ASSERT_TRUE(mapper.RefineMarkers().success);
+  const Eigen::Quaterniond& truth = scene.truth.markers[wrong.value].world_from_marker.rotation;
+  EXPECT_LT(RotationAngle(mapper.landmarks().Find(wrong)->world_from_marker.rotation *
+                          truth.inverse()),
+            0.05);
+  EXPECT_LT(PositionError(*mapper.landmarks().Find(wrong), scene.truth), 0.01);
+}
+
 TEST(MarkerMapperTest, WithoutAnySizeUnknownMarkersAreNotMapped) {
   MappedScene scene;
   Build(scene, Sim3(), 0.0);

@@ -17,6 +17,7 @@
 #include "arucoslam/slam/relocalizer.h"
 #include "arucoslam/slam/tracker.h"
 #include "arucoslam/slam/world_alignment.h"
+#include "arucoslam/slam/covisible_marker_vote.h"
 #include "arucoslam/slam/world_rotation_vote.h"
 
 namespace arucoslam {
@@ -169,6 +170,12 @@ void VisitOptions(MarkerMapperOptions& o, Visitor& visit) {
         "... plus this fraction of the view's distance");
   visit("max_pending_views", o.max_pending_views,
         "views an unmapped marker keeps (oldest dropped)");
+  visit("marker_views", o.marker_views,
+        "frames posed by markers alone map unknown markers too (no keypoint map needed)");
+  visit("marker_view_min_translation_fraction", o.marker_view_min_translation_fraction,
+        "a marker view is taken this fraction of its nearest marker's distance from the others");
+  visit("marker_view_min_rotation_deg", o.marker_view_min_rotation_deg,
+        "... or turned this many degrees from them");
   visit("corner_sigma_px", o.corner_sigma_px, "corner noise of the adjustment, pixels");
   visit("balance_corner_sigma", o.balance_corner_sigma,
         "re-estimate the corner sigma from the residuals and solve again");
@@ -256,6 +263,18 @@ void VisitOptions(WorldRotationVoteOptions& o, Visitor& visit) {
   visit("min_support", o.min_support, "views agreeing with the winner, itself included");
   visit("min_margin", o.min_margin, "the winner's support over the best rival's (> 1)");
   visit("max_views", o.max_views, "views kept, the newest");
+}
+
+template <class Visitor>
+void VisitOptions(CovisibleMarkerVoteOptions& o, Visitor& visit) {
+  visit("max_frames", o.max_frames, "ambiguous frames kept to vote with, the newest");
+  visit("max_disagreement_m", o.max_disagreement_m,
+        "a marker centre agrees between two frames within this, metres ...");
+  visit("max_disagreement_fraction", o.max_disagreement_fraction,
+        "... plus this fraction of its distance");
+  visit("min_agreement_margin", o.min_agreement_margin,
+        "a frame pair votes when one solution puts this many more markers in agreement");
+  visit("min_votes", o.min_votes, "votes for one solution (none for the other) that settle it");
 }
 
 }  // namespace arucoslam

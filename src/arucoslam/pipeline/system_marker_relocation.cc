@@ -1,0 +1,89 @@
+// System::RelocateMarkerPoses: at Finish, once markers were mapped during the run, the frames
+// whose poses came from markers are located again against the final (refined) marker map,
+// and the frames that saw markers but got no pose (an ambiguity not settled yet, markers
+// not mapped yet) are located in it too.
+#include <algorithm>
+#include <set>
+
+#include "arucoslam/pipeline/system.h"
+#include "arucoslam/util/logging.h"
+
+namespace arucoslam {
+
+std::optional<Rigid3> System::LocateInFinalMap(const std::vector<MarkerObservation>& markers,
+                                               const MarkerMap& final_map,
+                                               const std::optional<Rigid3>& previous) const {
+  std::vector<MarkerDetection> detections;
+  for (const MarkerObservation& observation : markers) {
+    MarkerDetection detection;
+    detection.id = observation.marker_id.value;
+    detection.corners = observation.corners_px;
+    detections.push_back(detection);
+  }
+  const CameraLocation location = LocateCamera(detections, final_map, camera_, options_.locator);
+  if (!location.found) return std::nullopt;
+  // An ambiguous location keeps the solution near the frame's earlier pose; without one it
+  // is not used.
+  AmbiguityChoice choice = AmbiguityChoice::kBest;
+  if (location.quality.ambiguous) {
+    choice = previous ? ResolveAmbiguity(location, previous->Inverse(), options_.ambiguity_gates)
+                      : AmbiguityChoice::kNone;
+  }
+  if (choice == AmbiguityChoice::kNone) return std::nullopt;
+  double nearest_sides = 0.0;
+  if (!UsableLocation(location, choice == AmbiguityChoice::kAlternative, final_map,
+                      &nearest_sides)) {
+    return std::nullopt;
+  }
+  return ChosenPose(location, choice)->Inverse();
+}
+
+void System::RelocateMarkerPoses() {
+  if (!marker_mapper_ || !options_.relocate_marker_poses) return;
+  const MarkerMap final_map = marker_mapper_->ToMarkerMap();
+  const bool any_mapped = std::any_of(final_map.markers.begin(), final_map.markers.end(),
+                                      [](const auto& entry) { return !entry.second.fixed; });
+  if (!any_mapped) return;  // the frames were located in this map already
+  int relocated = 0, late = 0;
+  std::set<double> posed;
+  for (TrackedPose& pose : poses_) {
+    if (pose.in_world || pose.marker_cam_from_world) posed.insert(pose.timestamp_s);
+    if (pose.seen_markers.empty()) continue;
+    // A keypoint pose outside the world keeps its marker location as its pose; a marker-only
+    // or frozen one has no reference keyframe.
+    const bool fallback = !pose.in_world && pose.marker_cam_from_world;
+    if (!fallback && pose.reference.IsValid()) continue;
+    const Rigid3 current = fallback ? *pose.marker_cam_from_world : pose.cam_from_world;
+    const std::optional<Rigid3> located = LocateInFinalMap(pose.seen_markers, final_map, current);
+    if (!located) continue;
+    if (fallback) {
+      pose.marker_cam_from_world = located;
+    } else {
+      pose.cam_from_world = *located;
+      pose.cam_from_reference = *located;
+    }
+    ++relocated;
+  }
+  for (const UnposedMarkerFrame& frame : unposed_marker_frames_) {
+    if (posed.count(frame.timestamp_s) != 0) continue;  // posed later (a backfill)
+    const std::optional<Rigid3> located = LocateInFinalMap(frame.markers, final_map, {});
+    if (!located) continue;
+    TrackedPose pose;
+    pose.timestamp_s = frame.timestamp_s;
+    pose.cam_from_world = pose.cam_from_reference = *located;
+    pose.in_world = true;
+    poses_.push_back(std::move(pose));
+    ++late;
+  }
+  unposed_marker_frames_.clear();
+  std::stable_sort(poses_.begin(), poses_.end(), [](const TrackedPose& a, const TrackedPose& b) {
+    return a.timestamp_s < b.timestamp_s;
+  });
+  ARUCOSLAM_LOG_DEBUG("final marker map: {} marker poses located again, {} frames posed late",
+                      relocated, late);
+  std::lock_guard lock(stats_mutex_);
+  stats_.num_relocated_marker_poses = relocated;
+  stats_.num_late_marker_poses = late;
+}
+
+}  // namespace arucoslam
