@@ -128,11 +128,12 @@ ExperimentRun MarkerSlamRun(const fs::path& sequence, const fs::path& out_dir,
   run.available = true;
   run.median_frame_ms = result.timing.frame_ms.Summarize().median;
   run.note = fmt::format(
-      "{} of {} frames with a pose ({} from markers alone), {} losses, {} marker "
+      "{} of {} frames with a pose ({} from markers alone; {} without a pose saw no marker), "
+      "{} losses, {} marker "
       "relocalisations, {} world alignments ({} maps initialised from markers), {} new maps "
       "after a loss ({} never aligned, left out), {} keyframes, {} map points in the last map{}",
       result.stats.frames_tracked, result.stats.frames, result.timing.num_marker_only_poses,
-      result.stats.losses, result.timing.num_marker_relocalizations,
+      result.timing.num_unposed_without_markers, result.stats.losses, result.timing.num_marker_relocalizations,
       result.timing.num_world_alignments, result.timing.num_marker_initializations,
       result.timing.num_new_maps_after_loss, result.timing.num_maps_discarded,
       result.stats.keyframes, result.stats.map_points,

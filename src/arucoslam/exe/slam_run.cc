@@ -29,6 +29,7 @@ SlamRunStats MakeStats(const std::string& dataset_label, const FrameSource& sour
   out.dataset = dataset_label;
   out.layout = source.layout();
   out.frames_dropped = static_cast<int>(source.frames_dropped());
+  out.frames_unposed_without_markers = stats.num_unposed_without_markers;
   out.blocking = blocking;
   out.markers = markers;
   out.frames = stats.num_frames;

@@ -36,6 +36,7 @@ std::string FormatSlamStatsJson(const SlamRunStats& stats) {
       {"dropped", stats.frames_dropped},
       {"tracked_fraction",
        stats.frames > 0 ? static_cast<double>(stats.frames_tracked) / stats.frames : 0.0}};
+  if (stats.markers) json["frames"]["unposed_without_markers"] = stats.frames_unposed_without_markers;
   json["tracking"] = {{"losses", stats.losses},
                       {"relocalisations", stats.relocalisations},
                       {"initialization_attempts", stats.initialization_attempts},

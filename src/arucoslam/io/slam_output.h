@@ -26,6 +26,8 @@ struct SlamRunStats {
   int frames_lost = 0;
   int inconsistent_poses = 0;  // tracked, left out of the trajectory: off their keyframes
   int frames_dropped = 0;      // live camera: captured but never processed (the SLAM was busy)
+  // With markers: frames without a pose that saw no marker either (nothing to locate them).
+  int frames_unposed_without_markers = 0;
   bool interrupted = false;    // the run stopped early on request (Ctrl-C)
   int losses = 0;              // transitions tracking -> lost
   int relocalisations = 0;
@@ -69,7 +71,7 @@ struct SlamRunStats {
 // ASCII PLY with one vertex (x y z, double) per point.
 std::string FormatPlyPoints(const std::vector<Eigen::Vector3d>& points);
 // stats.json text: {"format": "arucoslam.stats/1", "dataset", "layout", "interrupted",
-// "frames": {..., "left_out", "dropped"},
+// "frames": {..., "left_out", "dropped", with markers "unposed_without_markers"},
 // "tracking": {"losses", "relocalisations", ...}, "map": {..., "loops_closed",
 // "global_bundle_adjustments", "refined_frame_poses", "yielded_bundle_adjustments"}, with markers
 // "marker_locations":

@@ -255,6 +255,9 @@ FrameReport System::ProcessFrame(Frame frame, const std::vector<MarkerDetection>
     ++stats_.num_frames;
     if (report.cam_from_world) ++stats_.num_tracked;
     if (report.state == TrackingState::kLost) ++stats_.num_lost;
+    if (options_.marker_map && !report.cam_from_world && frame.markers.empty()) {
+      ++stats_.num_unposed_without_markers;
+    }
     stats_.tracking_ms.Add(watch.ElapsedMilliseconds());
   }
   if (pending_keyframe_) {

@@ -302,6 +302,9 @@ struct SystemStats {
   int num_frames = 0;
   int num_tracked = 0;           // frames with a pose
   int num_lost = 0;              // frames in state lost
+  // With a marker map: frames left without a pose that saw no marker either (facing a plain
+  // wall between markers): where more markers, not better tracking, would help.
+  int num_unposed_without_markers = 0;
   int num_losses = 0;            // transitions tracking -> lost
   int num_initialization_attempts = 0;
   int num_initializations = 0;

@@ -208,6 +208,8 @@ TEST(SystemMarkers, FirstMarkerAfterBlackoutGivesAccuratePose) {
   // A 2 s blackout (40 frames) after the map is aligned.
   const MarkerRun run = RunWithMarkers(true, 110, 50, 90);
   EXPECT_GE(run.stats.num_losses, 1);
+  // The blackout's frames are the ones left without a pose and without a marker in view.
+  EXPECT_EQ(run.stats.num_unposed_without_markers, 40);
   const FrameReport& first = run.reports[90];
   ASSERT_TRUE(first.cam_from_world.has_value()) << first.message;
   const Eigen::Vector3d centre = first.cam_from_world->Inverse().translation;
