@@ -17,7 +17,7 @@ namespace arucoslam::testing_util {
 inline SplitCommandResult MakeAisleWorld(const std::filesystem::path& dir) {
   WriteEuRoCSensorYaml(PinholeCamera(320, 240, 230.0), dir / "camera.yaml");
   return RunArucoslamSplit(
-      "world factory --seed 3 --aisles 1 --aisle-length 8 "
+      "world factory --seed 3 --aisles 1 --aisle-length 8 --wall-markers 0 "
       "--markers-per-dock 4 --marker-size 0.3 --out " +
           (dir / "world").string(),
       dir);

@@ -219,8 +219,15 @@ ExperimentsResult RunExperiments(const ExperimentsOptions& options) {
 
   const Dataset reference = Dataset::Open(with_markers);
   result.table = FormatExperimentsTable(result.runs);
+  const std::string world =
+      !options.world_description.empty()
+          ? options.world_description
+          : fmt::format("{}, {} markers in its markers.json", options.world_dir.string(),
+                        reference.markers_path() ? ReadMarkerMapJson(*reference.markers_path())
+                                                       .markers.size()
+                                                 : 0u);
   WriteExperimentsReport(reference.ground_truth(), result.runs, result.table, staged.path(),
-                         with_markers / "world.sdf");
+                         with_markers / "world.sdf", world);
   staged.Commit();
   return result;
 }

@@ -31,6 +31,9 @@ struct ExperimentsOptions {
   // The route is a ground vehicle's: run 1 (the one in the marker world) holds its keyframes
   // near one camera height and tilt in the whole-map adjustment (`run --ground-vehicle`).
   bool ground_vehicle = true;
+  // One sentence on the world and its markers for the report (empty: the number of markers
+  // in world_dir's markers.json).
+  std::string world_description;
 
   bool Check(std::string* why = nullptr) const {
     OptionCheck check(why);

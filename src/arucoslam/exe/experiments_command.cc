@@ -1,7 +1,10 @@
 // `arucoslam experiments` and `arucoslam demo`: the paper's three experiments on a world,
 // and the same on the built-in default factory (what `make demo` runs).
+#include <fmt/format.h>
+
 #include <cstdio>
 #include <filesystem>
+#include <string>
 
 #include "arucoslam/exe/command.h"
 #include "arucoslam/exe/default_vocabulary.h"
@@ -23,17 +26,28 @@ void PrintResult(const ExperimentsResult& result, const fs::path& out_dir) {
   std::printf("report: %s\n", (out_dir / "report.html").string().c_str());
 }
 
-// The default factory twice from one seed: with markers at the docks and without.
-void WriteDefaultWorlds(std::uint32_t seed, const fs::path& with_markers,
-                        const fs::path& without_markers) {
+// The default factory twice from one seed: with markers (at the docks and every metre along
+// the corridor wall) and without. Returns the report's sentence on the world.
+std::string WriteDefaultWorlds(std::uint32_t seed, const fs::path& with_markers,
+                               const fs::path& without_markers) {
   FactoryOptions options;
   options.seed = seed;
   options.texture = TextureLevel::kLow;  // the paper's homogeneous environment
   fs::create_directories(with_markers);
-  WriteFactoryWorld(BuildFactoryWorld(options), with_markers);
+  const FactoryWorld world = BuildFactoryWorld(options);
+  WriteFactoryWorld(world, with_markers);
+  std::size_t dock_markers = 0;
+  for (const FactoryDock& dock : world.docks) dock_markers += dock.marker_ids.size();
+  const std::string description = fmt::format(
+      "the default factory (seed {}, low texture) with {} markers of {:.2f} m: {} at the docks "
+      "and {} on the corridor wall, one every {:g} m as the ArucoSLAM authors' simulation has "
+      "them (`world factory --wall-markers 0` leaves the docks only)",
+      seed, world.markers.markers.size(), options.marker_size_m, dock_markers,
+      world.markers.markers.size() - dock_markers, options.wall_marker_spacing_m);
   options.markers = false;
   fs::create_directories(without_markers);
   WriteFactoryWorld(BuildFactoryWorld(options), without_markers);
+  return description;
 }
 
 }  // namespace
@@ -88,7 +102,8 @@ void AddDemoCommand(CLI::App& app, int& exit_status) {
     options.world_without_markers_dir = staged.path() / "world_without_markers";
     options.out_dir = staged.path() / "experiments";
     options.max_seconds = *max_seconds;
-    WriteDefaultWorlds(*seed, options.world_dir, *options.world_without_markers_dir);
+    options.world_description =
+        WriteDefaultWorlds(*seed, options.world_dir, *options.world_without_markers_dir);
     const ExperimentsResult result = RunExperiments(options);
     staged.Commit();
     PrintResult(result, fs::path(*out) / "experiments");

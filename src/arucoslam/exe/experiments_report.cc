@@ -120,13 +120,15 @@ std::string HtmlEscape(const std::string& text) {
 }
 
 std::string HtmlReport(const std::vector<ExperimentRun>& runs,
-                       const std::vector<std::string>& plot_files) {
+                       const std::vector<std::string>& plot_files, const std::string& world) {
   std::string html =
       "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>ArucoSLAM experiments</title>"
       "<style>body{font-family:sans-serif;max-width:1100px;margin:2em auto}"
       "table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:4px 8px;"
       "text-align:right}td:first-child,th:first-child{text-align:left}</style></head><body>\n"
-      "<h1>ArucoSLAM experiments</h1>\n<table>\n<tr><th>metric</th>";
+      "<h1>ArucoSLAM experiments</h1>\n";
+  if (!world.empty()) html += "<p>World: " + HtmlEscape(world) + "</p>\n";
+  html += "<table>\n<tr><th>metric</th>";
   for (const ExperimentRun& run : runs) html += "<th>" + HtmlEscape(run.label) + "</th>";
   html += "</tr>\n";
   for (const Row& row : TableRows()) {
@@ -176,7 +178,8 @@ std::string FormatExperimentsTable(const std::vector<ExperimentRun>& runs) {
 
 void WriteExperimentsReport(const Trajectory& ground_truth, const std::vector<ExperimentRun>& runs,
                             const std::string& table, const std::filesystem::path& dir,
-                            const std::optional<std::filesystem::path>& world_sdf) {
+                            const std::optional<std::filesystem::path>& world_sdf,
+                            const std::string& world) {
   WriteTextFileAtomically(dir / "table.txt", table);
   std::vector<TrajectoryEvaluation> absolute;
   std::vector<TrajectoryEvaluation> aligned;
@@ -200,11 +203,13 @@ void WriteExperimentsReport(const Trajectory& ground_truth, const std::vector<Ex
   }
   write_plots(absolute, "world_");
   write_plots(aligned, "sim3_aligned_");
-  std::string markdown = "# ArucoSLAM experiments\n\n" + MarkdownTable(runs) + "\n## Runs\n\n" +
+  std::string markdown = "# ArucoSLAM experiments\n\n" +
+                         (world.empty() ? "" : "World: " + world + "\n\n") +
+                         MarkdownTable(runs) + "\n## Runs\n\n" +
                          NotesMarkdown(runs) + "\n## Plots\n\n";
   for (const std::string& file : plot_files) markdown += "![" + file + "](" + file + ")\n\n";
   WriteTextFileAtomically(dir / "report.md", markdown);
-  WriteTextFileAtomically(dir / "report.html", HtmlReport(runs, plot_files));
+  WriteTextFileAtomically(dir / "report.html", HtmlReport(runs, plot_files, world));
 }
 
 }  // namespace arucoslam

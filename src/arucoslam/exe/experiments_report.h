@@ -14,8 +14,10 @@ namespace arucoslam {
 
 // Writes table.txt, plots (*.svg), report.md and report.html into `dir`; with a world file
 // also floor_plan.svg (the runs over the world's plan).
+// `world` describes the world and its markers in a sentence (empty: left out).
 void WriteExperimentsReport(const Trajectory& ground_truth, const std::vector<ExperimentRun>& runs,
                             const std::string& table, const std::filesystem::path& dir,
-                            const std::optional<std::filesystem::path>& world_sdf = std::nullopt);
+                            const std::optional<std::filesystem::path>& world_sdf = std::nullopt,
+                            const std::string& world = "");
 
 }  // namespace arucoslam

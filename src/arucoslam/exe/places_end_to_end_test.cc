@@ -157,7 +157,7 @@ std::shared_ptr<const Vocabulary>* PlacesEndToEnd::vocabulary_ = nullptr;
 // correction there and the ATE only goes from 1.58 m to 1.11 m.
 TEST_F(PlacesEndToEnd, ClosingTheLoopAtLeastHalvesTheError) {
   const fs::path sequence = RenderSequence(*dir_, "loop",
-                                           "--seed 3 --texture medium --aisles 1 --aisle-length 6",
+                                           "--seed 3 --texture medium --aisles 1 --aisle-length 6 --wall-markers 0",
                                            0.0, true);
   const Dataset dataset = Dataset::Open(sequence);
   // FAST down to 5 grey levels as `arucoslam run` sets it (DefaultRunOptions, exe/slam_run.cc).
@@ -188,7 +188,7 @@ TEST_F(PlacesEndToEnd, ClosingTheLoopAtLeastHalvesTheError) {
 // kept until the correction is spread along the loop.
 TEST_F(PlacesEndToEnd, DISABLED_ClosingTheLoopKeepsTheFrameToFrameError) {
   const fs::path sequence = RenderSequence(*dir_, "loop",
-                                           "--seed 3 --texture medium --aisles 1 --aisle-length 6",
+                                           "--seed 3 --texture medium --aisles 1 --aisle-length 6 --wall-markers 0",
                                            0.0, true);
   const Dataset dataset = Dataset::Open(sequence);
   const int fast_threshold = 5;
@@ -207,7 +207,7 @@ TEST_F(PlacesEndToEnd, DISABLED_ClosingTheLoopKeepsTheFrameToFrameError) {
 // 0.105 m: what the gap costs is now visible, and left to improve.)
 TEST_F(PlacesEndToEnd, TrackingResumesWithinOneSecondAfterATwoSecondGap) {
   const fs::path sequence = RenderSequence(
-      *dir_, "gap", "--seed 3 --texture medium --aisles 1 --aisle-length 6", 9.0, true);
+      *dir_, "gap", "--seed 3 --texture medium --aisles 1 --aisle-length 6 --wall-markers 0", 9.0, true);
   const Dataset dataset = Dataset::Open(sequence);
   ASSERT_GE(dataset.size(), 130u);
   const std::size_t gap_begin = 45, gap_end = 75;  // 3.0 s to 5.0 s at 15 Hz
@@ -236,7 +236,7 @@ TEST_F(PlacesEndToEnd, TrackingResumesWithinOneSecondAfterATwoSecondGap) {
 // world-frame ATE 0.104 m open, 0.042 m closed, one loop.
 TEST_F(PlacesEndToEnd, ALoopClosedInTheMarkerWorldStaysInTheWorld) {
   const fs::path sequence = RenderSequence(*dir_, "loop",
-                                           "--seed 3 --texture medium --aisles 1 --aisle-length 6",
+                                           "--seed 3 --texture medium --aisles 1 --aisle-length 6 --wall-markers 0",
                                            0.0, true);
   const Dataset dataset = Dataset::Open(sequence);
   ASSERT_TRUE(dataset.markers_path().has_value());

@@ -230,7 +230,8 @@ class SimulatedVideoTest : public ::testing::Test {
     fs::remove_all(dir_);
     fs::create_directories(dir_);
     SplitCommandResult result =
-        Run("world factory --seed 3 --aisles 1 --aisle-length 8 --markers-per-dock 4 "
+        Run("world factory --seed 3 --aisles 1 --aisle-length 8 --wall-markers 0 "
+            "--markers-per-dock 4 "
             "--marker-size 0.3 --out " +
             (dir_ / "world").string());
     ASSERT_EQ(result.status, 0) << result.err;

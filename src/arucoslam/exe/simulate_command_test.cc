@@ -25,7 +25,7 @@ class SimulateCommandTest : public ::testing::Test {
     dir_ = fs::temp_directory_path() / ("arucoslam_simulate_test_" + std::to_string(getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
-    const Result factory = Run("world factory --seed 3 --aisles 1 --aisle-length 8 --out " +
+    const Result factory = Run("world factory --seed 3 --aisles 1 --aisle-length 8 --wall-markers 0 --out " +
                                (dir_ / "factory").string());
     ASSERT_EQ(factory.status, 0) << factory.err;
   }

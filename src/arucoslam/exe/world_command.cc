@@ -84,7 +84,8 @@ void AddWorldCommand(CLI::App& app, int& exit_status) {
       ->capture_default_str();
   factory->add_option("--texture", args->texture, "surface detail and clutter: low, medium, high")
       ->capture_default_str();
-  factory->add_option("--markers", args->markers, "markers at the docks: on or off")
+  factory->add_option("--markers", args->markers,
+                      "markers at the docks and on the corridor wall (--wall-markers): on or off")
       ->capture_default_str();
   factory
       ->add_option("--marker-size", args->options.marker_size_m,
@@ -101,8 +102,9 @@ void AddWorldCommand(CLI::App& app, int& exit_status) {
                     "the route faces while it turns there)");
   factory
       ->add_option("--wall-markers", args->options.wall_marker_spacing_m,
-                   "marker boards along the corridor's long wall every this many metres, 1-20 "
-                   "(0: none; the ArucoSLAM authors' simulation has one every metre)")
+                   "marker boards along the corridor's long wall every this many metres, 1-20, "
+                   "as the ArucoSLAM authors' simulation has them (0: none, markers at the docks "
+                   "only)")
       ->capture_default_str();
   factory
       ->add_option("--camera-height", args->options.camera_height_m,

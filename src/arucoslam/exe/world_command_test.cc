@@ -34,7 +34,7 @@ class WorldCommandTest : public ::testing::Test {
 TEST_F(WorldCommandTest, WritesTheFactoryFolder) {
   const fs::path out = dir_ / "factory";
   const auto result = RunArucoslam(
-      "world factory --seed 3 --aisles 2 --aisle-length 12 --texture low "
+      "world factory --seed 3 --aisles 2 --aisle-length 12 --texture low --wall-markers 0 "
       "--markers-per-dock 2 --marker-size 0.25 --out " +
       out.string());
   ASSERT_EQ(result.status, 0) << result.output;

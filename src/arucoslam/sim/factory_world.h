@@ -29,11 +29,12 @@ struct FactoryOptions {
   // the end wall, facing into the corridor: the wall a robot faces while it turns there.
   // Ids after the docks'. Only with markers.
   bool corridor_end_markers = false;
-  // Marker boards along the same wall every this many metres (0: none), from the first
-  // corridor-end position to the last, boards that would cover a pillar left out; ids after
-  // the docks'. The ArucoSLAM authors' simulation (LOGNAV) lines one wall with a marker
-  // every metre; the docks alone leave the corridor's 20 m without one. Only with markers.
-  double wall_marker_spacing_m = 0.0;
+  // Marker boards along the same wall every this many metres (0: none, the docks only), from
+  // the first corridor-end position to the last, boards that would cover a pillar left out;
+  // ids after the docks'. As the ArucoSLAM authors' simulation (LOGNAV) lines one wall: a
+  // marker every metre; the docks alone leave the corridor's 20 m without one. Only with
+  // markers.
+  double wall_marker_spacing_m = 1.0;
   int marker_image_px = 240;     // marker PNG: side of the black square, pixels
   double camera_height_m = 0.6;  // marker centres and the route's camera, [0.3, 1.0] m
 

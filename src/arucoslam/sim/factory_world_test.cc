@@ -137,6 +137,7 @@ double DistanceDrivenFacing(const std::vector<TimedPose>& poses, const Eigen::Ve
 // is ahead of the camera, within 25 degrees of its axis, with its +z facing the camera.
 TEST_F(FactoryWorldTest, DockMarkersFaceTheApproach) {
   FactoryOptions options;
+  options.wall_marker_spacing_m = 0.0;  // the docks only
   options.markers_per_dock = 2;
   const FactoryWorld world = BuildFactoryWorld(options);
   const std::vector<TimedPose> poses = GenerateCameraPath(world.default_route, PathRun::kTeach);
@@ -192,8 +193,9 @@ Eigen::Quaterniond ToEigen(const ignition::math::Quaterniond& q) {
 // (the dock markers unchanged), and the default route faces the east one in its turn: within
 // 35 degrees of the camera axis and 4 m for at least 0.3 m of driving.
 TEST_F(FactoryWorldTest, CorridorEndMarkersFaceTheRouteInItsTurn) {
-  const FactoryWorld plain = BuildFactoryWorld(FactoryOptions{});
   FactoryOptions options;
+  options.wall_marker_spacing_m = 0.0;  // the docks only
+  const FactoryWorld plain = BuildFactoryWorld(options);
   options.corridor_end_markers = true;
   const FactoryWorld world = BuildFactoryWorld(options);
   ASSERT_EQ(world.markers.markers.size(), plain.markers.markers.size() + 2);
@@ -222,8 +224,9 @@ TEST_F(FactoryWorldTest, CorridorEndMarkersFaceTheRouteInItsTurn) {
 // corridor-end flag adds no second board at the ends; too many boards for the dictionary
 // and a spacing out of range are refused.
 TEST_F(FactoryWorldTest, WallMarkersLineTheCorridorClearOfThePillars) {
-  const FactoryWorld plain = BuildFactoryWorld(FactoryOptions{});
   FactoryOptions options;
+  options.wall_marker_spacing_m = 0.0;  // the docks only
+  const FactoryWorld plain = BuildFactoryWorld(options);
   options.wall_marker_spacing_m = 3.0;
   const FactoryWorld world = BuildFactoryWorld(options);
   const int docks = static_cast<int>(plain.markers.markers.size());
@@ -276,6 +279,7 @@ TEST_F(FactoryWorldTest, SdformatParsesTheWorldAndMarkerPosesMatchTheJson) {
   options.aisles = 2;
   options.aisle_length_m = 12.0;
   options.markers_per_dock = 2;
+  options.wall_marker_spacing_m = 0.0;  // the docks only
   options.texture = TextureLevel::kHigh;
   const fs::path dir = Write(options, "sdf");
   sdf::Root root;
@@ -325,6 +329,7 @@ TEST_F(FactoryWorldTest, SdformatParsesTheWorldAndMarkerPosesMatchTheJson) {
 
 TEST_F(FactoryWorldTest, MarkersOffAndBadOptions) {
   FactoryOptions options;
+  options.wall_marker_spacing_m = 0.0;  // the docks only
   options.markers = false;
   const FactoryWorld world = BuildFactoryWorld(options);
   EXPECT_TRUE(world.markers.markers.empty());
