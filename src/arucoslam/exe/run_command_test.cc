@@ -61,7 +61,7 @@ TEST_F(RunCommandTest, RealStaticEurocSequenceWritesOutputsWithoutAMap) {
   const fs::path out = dir_ / "out";
   const Outcome outcome = Run("run --dataset " + data.string() + " --out " + out.string() + " --blocking");
   ASSERT_EQ(outcome.status, 0) << outcome.err;
-  for (const char* name : {"trajectory.tum", "keyframes.tum", "map.ply", "stats.json"}) {
+  for (const char* name : {"trajectory.tum", "online.tum", "keyframes.tum", "map.ply", "stats.json"}) {
     EXPECT_TRUE(fs::is_regular_file(out / name)) << name;
   }
   // A camera standing still gives no map: no pose, no keyframe, no point.
@@ -136,6 +136,10 @@ TEST_F(RunCommandTest, MovingCameraOverPlaneIsTracked) {
   const Eigen::Vector3d x_axis = trajectory.poses.front().rotation * Eigen::Vector3d::UnitX();
   EXPECT_GT(std::abs(travel.normalized().dot(x_axis)), 0.98);
   EXPECT_GE(ReadTumTrajectory(out / "keyframes.tum").size(), 2u);
+  // Without markers each tracked frame's pose as it was tracked (the backfilled ones not), in
+  // the map's own frame.
+  const Trajectory online = ReadTumTrajectory(out / "online.tum");
+  EXPECT_GE(online.size(), static_cast<std::size_t>(num_frames / 2));
   EXPECT_EQ(outcome.err.find("\rframe"), std::string::npos);  // --quiet
 }
 

@@ -131,6 +131,7 @@ SlamRunResult RunSlamOnSource(FrameSource& source, const std::string& dataset_la
   if (total && control.max_frames > 0) total = std::min(*total, control.max_frames);
   std::size_t processed = 0;
   bool interrupted = false;
+  Trajectory online;  // each frame's pose as its FrameReport gave it
   while (control.max_frames == 0 || processed < control.max_frames) {
     if (stop_requested()) {
       interrupted = true;
@@ -143,6 +144,7 @@ SlamRunResult RunSlamOnSource(FrameSource& source, const std::string& dataset_la
     }
     const FrameReport report = system.ProcessImage(frame->image, frame->timestamp_s);
     ++processed;
+    if (report.online_world_from_cam) online.Add(report.timestamp_s, *report.online_world_from_cam);
     if (progress && (processed % 10 == 1 || (total && processed == *total))) {
       std::fprintf(stderr, "\rframe %zu%s  %-15s keyframes %zu  points %zu", processed,
                    total ? fmt::format("/{}", *total).c_str() : "",
@@ -163,6 +165,7 @@ SlamRunResult RunSlamOnSource(FrameSource& source, const std::string& dataset_la
   result.map_points = system.MapPoints();
   WriteSlamOutput(staged.path(), result.trajectory, result.keyframes, result.map_points,
                   result.stats);
+  WriteTumTrajectory(staged.path() / "online.tum", online);
   if (!reuse.save.empty()) {
     MapFileInfo info;
     info.world_aligned = system.world_aligned();

@@ -1,6 +1,6 @@
 // RunSlamOnSource: one SLAM run over a frame source (file sequence, video or live camera),
 // shared by `run` and `experiments`: feeds every frame to the System, then writes trajectory.tum,
-// keyframes.tum, map.ply and stats.json (and with a marker map markers.json: known + mapped
+// online.tum (FrameReport::online_world_from_cam), keyframes.tum, map.ply and stats.json (and with a marker map markers.json: known + mapped
 // markers) into an output folder (all-or-nothing); optionally starts from a saved map and saves the
 // map after the run.
 #pragma once

@@ -250,6 +250,11 @@ FrameReport System::ProcessFrame(Frame frame, const std::vector<MarkerDetection>
     unposed_marker_frames_.push_back({frame.timestamp_s, frame.markers});
   }
   report.world_aligned = world_aligned_;
+  if (fix_) report.marker_world_from_cam = fix_->world_from_cam;
+  const bool in_world = !options_.marker_map || world_aligned_ || report.marker_pose;
+  if (report.cam_from_world && in_world) {
+    report.online_world_from_cam = report.cam_from_world->Inverse();
+  }
   {
     std::lock_guard lock(stats_mutex_);
     ++stats_.num_frames;

@@ -291,6 +291,12 @@ struct FrameReport {
   std::vector<MarkerDetection> markers;  // all markers detected in the image (ProcessImage)
   bool marker_pose = false;   // the pose comes from the markers alone
   bool world_aligned = false; // the keypoint map is in the marker world frame (metric)
+  // The frame's usable marker location (marker map only), world_from_cam.
+  std::optional<Rigid3> marker_world_from_cam;
+  // The frame's pose as known now (world_from_cam), what the ROS node publishes and `run`
+  // writes to online.tum: with a marker map only a pose in the marker world (aligned map or
+  // marker pose), without one the pose in the map's own frame.
+  std::optional<Rigid3> online_world_from_cam;
 };
 
 struct SystemStats {

@@ -372,6 +372,14 @@ void System::MaybeAlignWorld(Frame* frame) {
     ARUCOSLAM_LOG_DEBUG("world re-alignment stopped: the merged map is linked to this one");
     return;
   }
+  {
+    // An anchor the alignment found an outlier has a wrong marker location (a mirrored
+    // one-marker solution, a far marker): no drift correction may pull the map towards it.
+    std::lock_guard lock(keyframe_fixes_mutex_);
+    for (std::size_t i = 0; i < anchors.size(); ++i) {
+      if (!alignment.inliers[i]) keyframe_fixes_.erase(anchors[i].keyframe);
+    }
+  }
   // A merged map not linked yet stays where it is (already in the world).
   const std::set<KeyframeId>* stay = absorbed_keyframes_.empty() ? nullptr : &absorbed_keyframes_;
   const std::unique_lock<std::mutex> places_lock = LockPlacesForMapMove();

@@ -40,8 +40,7 @@ SlamUpdate SlamSession::Process(const cv::Mat& grey, double timestamp_s) {
   const FrameReport report = system_->ProcessImage(grey, timestamp_s);
   SlamUpdate update;
   update.timestamp_s = timestamp_s;
-  const bool in_world = !options_->marker_map || report.world_aligned || report.marker_pose;
-  if (report.cam_from_world && in_world) update.world_from_cam = report.cam_from_world->Inverse();
+  update.world_from_cam = report.online_world_from_cam;
   FrameStatus& status = update.status;
   status.state = TrackingStateName(report.state);
   status.has_pose = update.world_from_cam.has_value();
