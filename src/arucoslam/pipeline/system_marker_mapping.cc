@@ -94,14 +94,15 @@ void System::FeedMarkerView(const Frame& frame) {
 }
 
 void System::PublishLocatingMarkers() {
-  if (options_.min_locating_marker_keyframes <= 0) return;
   MarkerMap locating = *options_.marker_map;
   bool any = false;
   for (const auto& [id, landmark] : marker_mapper_->landmarks().landmarks()) {
-    if (landmark.fixed || locating.markers.count(id.value) != 0 ||
-        marker_mapper_->NumViews(id) < options_.min_locating_marker_keyframes) {
-      continue;
-    }
+    if (locating.markers.count(id.value) != 0) continue;
+    // A fixed marker the known map lacks is the world origin the mapper adopted.
+    const bool locates = landmark.fixed || (options_.min_locating_marker_keyframes > 0 &&
+                                            marker_mapper_->NumViews(id) >=
+                                                options_.min_locating_marker_keyframes);
+    if (!locates) continue;
     locating.markers[id.value] = landmark.ToMarkerInfo();
     any = true;
   }

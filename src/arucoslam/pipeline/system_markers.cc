@@ -72,6 +72,10 @@ std::optional<System::MarkerFix> System::LocateWithMarkers(
     Frame& frame, const std::vector<MarkerDetection>& detections, FrameReport& report) {
   if (!options_.marker_map) return std::nullopt;
   const Stopwatch watch;
+  if (options_.marker_map->markers.empty() && !detections.empty() && !marker_mapping_live_ &&
+      EnsureMarkerMapper().AdoptWorldOrigin(detections, frame.camera)) {
+    PublishLocatingMarkers();
+  }
   frame.markers.clear();
   for (const MarkerDetection& detection : detections) {
     frame.markers.push_back({MarkerId(detection.id), detection.corners});

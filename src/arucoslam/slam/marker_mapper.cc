@@ -84,6 +84,34 @@ bool MarkerMapper::AddMarkerView(const Rigid3& cam_from_world, const CameraModel
   return true;
 }
 
+bool MarkerMapper::AdoptWorldOrigin(const std::vector<MarkerDetection>& detections,
+                                    const CameraModel& camera) {
+  if (!landmarks_.empty() || !(unknown_size_ > 0.0) || detections.empty()) return false;
+  const auto area = [](const MarkerDetection& detection) {  // shoelace formula, pixels^2
+    double twice = 0.0;
+    for (int c = 0; c < 4; ++c) {
+      const Eigen::Vector2d& a = detection.corners[c];
+      const Eigen::Vector2d& b = detection.corners[(c + 1) % 4];
+      twice += a.x() * b.y() - b.x() * a.y();
+    }
+    return std::abs(twice) / 2.0;
+  };
+  const MarkerDetection* largest = &detections.front();
+  for (const MarkerDetection& detection : detections) {
+    if (area(detection) > area(*largest)) largest = &detection;
+  }
+  // Its corners must fit a square (not a false detection) to be the origin.
+  const std::optional<MarkerPose> pose =
+      EstimateMarkerPose(*largest, unknown_size_, camera, options_.marker_pose);
+  if (!pose || pose->Best().reprojection_rms_px > options_.max_initial_rms_px) return false;
+  MarkerLandmark origin;
+  origin.id = MarkerId(largest->id);
+  origin.size = unknown_size_;
+  origin.world_from_marker = Rigid3();
+  origin.fixed = true;
+  return landmarks_.Add(std::move(origin));
+}
+
 int MarkerMapper::NumViews(MarkerId id) const {
   const MarkerLandmark* landmark = landmarks_.Find(id);
   int count = landmark != nullptr ? static_cast<int>(landmark->observations.size()) : 0;

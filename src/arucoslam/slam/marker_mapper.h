@@ -108,6 +108,10 @@ class MarkerMapper {
                      const std::vector<MarkerObservation>& markers,
                      std::vector<MarkerId>* initialised);
   int NumMarkerViews() const { return num_marker_views_; }
+  // With no marker known and a size for unknown ones: the marker of `detections` that covers
+  // the most pixels becomes the world's origin (a fixed landmark at the identity), so that a
+  // marker map can start from the markers seen. Returns whether it did (once).
+  bool AdoptWorldOrigin(const std::vector<MarkerDetection>& detections, const CameraModel& camera);
   // Keyframes and retired records (marker views too) that saw marker `id`.
   int NumViews(MarkerId id) const;
   // Forgets a keyframe and every marker view it gave.

@@ -354,6 +354,44 @@ TEST(MarkerMapperTest, RefineMarkersTurnsAMarkerOutOfAWrongOrientation) {
   EXPECT_LT(PositionError(*mapper.landmarks().Find(wrong), scene.truth), 0.01);
 }
 
+// With no marker known, the largest marker of the first detections becomes the world's
+// origin, once, and only with a size for unknown markers.
+TEST(MarkerMapperTest, AdoptsTheLargestMarkerAsTheWorldOrigin) {
+  MappedScene scene;
+  Build(scene, Sim3(), 0.0);
+  std::vector<MarkerDetection> detections;
+  for (const MarkerObservation& observation : scene.markers[0]) {
+    detections.push_back({observation.marker_id.value, observation.corners_px});
+  }
+  ASSERT_GE(detections.size(), 2u);
+  MarkerMapper unsized(MarkerMap{});
+  EXPECT_FALSE(unsized.AdoptWorldOrigin(detections, scene.camera));
+  MarkerMapperOptions options;
+  options.unknown_marker_size_m = scene.options.marker_size_m;
+  EXPECT_FALSE(MarkerMapper(KnownMap(scene.truth), options)
+                   .AdoptWorldOrigin(detections, scene.camera));  // a marker is known
+  MarkerMapper mapper(MarkerMap{}, options);
+  ASSERT_TRUE(mapper.AdoptWorldOrigin(detections, scene.camera));
+  EXPECT_FALSE(mapper.AdoptWorldOrigin(detections, scene.camera));  // once
+  ASSERT_EQ(mapper.landmarks().size(), 1u);
+  const MarkerLandmark& origin = mapper.landmarks().landmarks().begin()->second;
+  EXPECT_TRUE(origin.fixed);
+  EXPECT_LT(origin.world_from_marker.translation.norm(), 1e-12);
+  // The nearest marker of the first view covers the most pixels.
+  const Rigid3& cam_from_world = scene.truth.keypoints.poses[0].cam_from_world;
+  double nearest = 1e9;
+  int nearest_id = -1;
+  for (const MarkerDetection& detection : detections) {
+    const double distance =
+        (cam_from_world * scene.truth.markers[detection.id].world_from_marker.translation).norm();
+    if (distance < nearest) {
+      nearest = distance;
+      nearest_id = detection.id;
+    }
+  }
+  EXPECT_EQ(origin.id.value, nearest_id);
+}
+
 TEST(MarkerMapperTest, WithoutAnySizeUnknownMarkersAreNotMapped) {
   MappedScene scene;
   Build(scene, Sim3(), 0.0);
