@@ -128,7 +128,7 @@ ExperimentRun MarkerSlamRun(const fs::path& sequence, const fs::path& out_dir,
   run.available = true;
   run.median_frame_ms = result.timing.frame_ms.Summarize().median;
   run.note = fmt::format(
-      "{} of {} frames with a pose ({} from markers alone; {} without a pose saw no marker), "
+      "{} of {} frames with a pose ({} from markers alone; of those without, {} saw no marker), "
       "{} losses, {} marker "
       "relocalisations, {} world alignments ({} maps initialised from markers), {} new maps "
       "after a loss ({} never aligned, left out), {} keyframes, {} map points in the last map{}",

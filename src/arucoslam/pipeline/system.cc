@@ -1,5 +1,7 @@
 #include "arucoslam/pipeline/system.h"
 
+#include <algorithm>
+#include <set>
 #include <stdexcept>
 #include <utility>
 
@@ -130,13 +132,20 @@ void System::Finish() {
   RelocateMarkerPoses();
   RefineFramePoses();
   int num_inconsistent = 0;
-  CheckedTrajectory(&num_inconsistent);
+  const std::vector<StampedPose> trajectory = CheckedTrajectory(&num_inconsistent);
+  // Frames seen without a pose or a marker that a backfill or the end posed do not count.
+  std::set<double> posed;
+  for (const StampedPose& pose : trajectory) posed.insert(pose.timestamp_s);
+  const int unposed_without_markers = static_cast<int>(std::count_if(
+      unposed_without_markers_s_.begin(), unposed_without_markers_s_.end(),
+      [&](double timestamp_s) { return posed.count(timestamp_s) == 0; }));
   if (num_inconsistent > 0) {
     ARUCOSLAM_LOG_DEBUG("{} frames left out of the trajectory: off their keyframes' path",
                         num_inconsistent);
   }
   std::lock_guard lock(stats_mutex_);
   stats_.num_inconsistent_poses = num_inconsistent;
+  stats_.num_unposed_without_markers = unposed_without_markers;
 }
 
 void System::WaitForMapping() {
@@ -261,7 +270,7 @@ FrameReport System::ProcessFrame(Frame frame, const std::vector<MarkerDetection>
     if (report.cam_from_world) ++stats_.num_tracked;
     if (report.state == TrackingState::kLost) ++stats_.num_lost;
     if (options_.marker_map && !report.cam_from_world && frame.markers.empty()) {
-      ++stats_.num_unposed_without_markers;
+      unposed_without_markers_s_.push_back(frame.timestamp_s);
     }
     stats_.tracking_ms.Add(watch.ElapsedMilliseconds());
   }

@@ -308,8 +308,9 @@ struct SystemStats {
   int num_frames = 0;
   int num_tracked = 0;           // frames with a pose
   int num_lost = 0;              // frames in state lost
-  // With a marker map: frames left without a pose that saw no marker either (facing a plain
-  // wall between markers): where more markers, not better tracking, would help.
+  // With a marker map, at Finish: frames without a pose in the trajectory that saw no marker
+  // either (facing a plain wall between markers): where more markers, not better tracking,
+  // would help.
   int num_unposed_without_markers = 0;
   int num_losses = 0;            // transitions tracking -> lost
   int num_initialization_attempts = 0;
@@ -652,6 +653,7 @@ class System {
   // Markers of the world-aligned map; only the mapping thread touches it while it runs.
   std::unique_ptr<MarkerMapper> marker_mapper_;
   std::vector<UnposedMarkerFrame> unposed_marker_frames_;
+  std::vector<double> unposed_without_markers_s_;  // frames seen without pose nor marker
   int marker_views_refined_ = 0;  // marker views at the last refinement (FeedMarkerView)
   bool marker_mapping_live_ = false;  // the current map is aligned and feeds marker_mapper_
   // Known + mapped markers that locate frames, published by the mapping thread.
