@@ -11,14 +11,18 @@
 #include "arucoslam/geometry/camera.h"
 #include "arucoslam/geometry/rigid3.h"
 #include "arucoslam/map/ids.h"
+#include "arucoslam/markers/detector.h"
 
 namespace arucoslam {
 
 // A marker seen in an image: its id and its four corners (distorted pixels, OpenCV order:
-// top-left, top-right, bottom-right, bottom-left). Filled by marker fusion (later issue).
+// top-left, top-right, bottom-right, bottom-left), as the System's marker handling records it.
 struct MarkerObservation {
   MarkerId marker_id;
   std::array<Eigen::Vector2d, 4> corners_px{};
+
+  // The same as a detection, for the marker pose and camera location functions.
+  MarkerDetection AsDetection() const { return {marker_id.value, corners_px}; }
 };
 
 // Feature access shared by Frame and Keyframe.

@@ -453,9 +453,9 @@ class System {
   std::optional<Rigid3> LocateInFinalMap(const std::vector<MarkerObservation>& markers,
                                          const MarkerMap& final_map,
                                          const std::optional<Rigid3>& previous) const;
+  // The detections of markers absent from the locating map.
   std::vector<MarkerDetection> UnknownDetections(
       const CameraLocation& location, const std::vector<MarkerDetection>& detections) const;
-  double UnknownMarkerSize() const;
   AmbiguityChoice ResolveByMotion(const CameraLocation& location, double timestamp_s,
                                   bool* by_map_rotation) const;
   // The frame's marker location minus the camera centre of `cam_from_world` (needs fix_).

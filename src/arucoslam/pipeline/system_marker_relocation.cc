@@ -15,10 +15,7 @@ std::optional<Rigid3> System::LocateInFinalMap(const std::vector<MarkerObservati
                                                const std::optional<Rigid3>& previous) const {
   std::vector<MarkerDetection> detections;
   for (const MarkerObservation& observation : markers) {
-    MarkerDetection detection;
-    detection.id = observation.marker_id.value;
-    detection.corners = observation.corners_px;
-    detections.push_back(detection);
+    detections.push_back(observation.AsDetection());
   }
   const CameraLocation location = LocateCamera(detections, final_map, camera_, options_.locator);
   if (!location.found) return std::nullopt;

@@ -94,7 +94,9 @@ std::optional<System::MarkerFix> System::LocateWithMarkers(
   if (choice == AmbiguityChoice::kNone && location.found && location.quality.ambiguous &&
       options_.resolve_ambiguity_by_covisible_markers) {
     choice = covisible_vote_.Add(location, UnknownDetections(location, detections),
-                                 UnknownMarkerSize(), frame.camera);
+                                 UnknownMarkerSize(*options_.marker_map,
+                                                   options_.marker_mapping.unknown_marker_size_m),
+                                 frame.camera);
     by_covisible = choice != AmbiguityChoice::kNone;
   }
   ambiguous_location_.reset();
@@ -165,14 +167,6 @@ std::vector<MarkerDetection> System::UnknownDetections(
     }
   }
   return unknown;
-}
-
-double System::UnknownMarkerSize() const {
-  if (options_.marker_mapping.unknown_marker_size_m > 0.0) {
-    return options_.marker_mapping.unknown_marker_size_m;
-  }
-  const MarkerMap& known = *options_.marker_map;
-  return known.markers.empty() ? 0.0 : known.markers.begin()->second.size;
 }
 
 bool System::UsableLocation(const CameraLocation& location, bool alternative,

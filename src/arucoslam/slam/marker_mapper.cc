@@ -16,12 +16,13 @@ constexpr double kDistinctRotationRad = 0.1;
 MarkerMapper::MarkerMapper(const MarkerMap& known, const MarkerMapperOptions& options)
     : options_(options),
       dictionary_(known.dictionary),
-      unknown_size_(options.unknown_marker_size_m),
-      landmarks_(MarkerLandmarks::FromMarkerMap(known)) {
-  if (!(unknown_size_ > 0.0) && !known.markers.empty()) {
-    unknown_size_ = known.markers.begin()->second.size;
-  }
-  if (!options.map_unknown) unknown_size_ = 0.0;
+      unknown_size_(options.map_unknown ? UnknownMarkerSize(known, options.unknown_marker_size_m)
+                                        : 0.0),
+      landmarks_(MarkerLandmarks::FromMarkerMap(known)) {}
+
+double UnknownMarkerSize(const MarkerMap& known, double configured_m) {
+  if (configured_m > 0.0 || known.markers.empty()) return configured_m;
+  return known.markers.begin()->second.size;
 }
 
 std::vector<MarkerId> MarkerMapper::AddKeyframe(KeyframeId keyframe, const Rigid3& cam_from_world,
@@ -211,11 +212,8 @@ int MarkerMapper::NumRetiredViews() const {
 
 void MarkerMapper::Observe(int record, const MarkerObservation& observation,
                            std::vector<MarkerId>* initialised) {
-  MarkerDetection detection;
-  detection.id = observation.marker_id.value;
-  detection.corners = observation.corners_px;
   const std::optional<MarkerPose> pose = EstimateMarkerPose(
-      detection, unknown_size_, records_.at(record).camera, options_.marker_pose);
+      observation.AsDetection(), unknown_size_, records_.at(record).camera, options_.marker_pose);
   if (!pose || pose->Best().reprojection_rms_px > options_.max_initial_rms_px) return;
   std::vector<View>& views = pending_[observation.marker_id];
   std::erase_if(views, [&](const View& view) { return view.record == record; });

@@ -88,6 +88,10 @@ struct MarkerMapperOptions {
   }
 };
 
+// The side of markers absent from `known`: `configured_m` when positive (unknown_marker_size_m),
+// else that of the known map's first marker (0 when it is empty too).
+double UnknownMarkerSize(const MarkerMap& known, double configured_m);
+
 class MarkerMapper {
  public:
   // `known`: the markers.json map; its markers are kept as they are (fixed or not).

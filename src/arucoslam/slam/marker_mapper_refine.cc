@@ -178,7 +178,7 @@ int MarkerMapper::ReconsiderMappedMarkers() {
   constexpr int kMaxCandidateViews = 12;  // views whose IPPE solutions are tried
   struct SeenBy {
     const Record* record;
-    const std::array<Eigen::Vector2d, 4>* corners_px;
+    const MarkerObservation* observation;
   };
   int moved = 0;
   for (const auto& [id, landmark] : landmarks_.landmarks()) {
@@ -186,7 +186,7 @@ int MarkerMapper::ReconsiderMappedMarkers() {
     std::vector<SeenBy> views;
     for (const auto& [index, record] : records_) {
       for (const MarkerObservation& observation : record.markers) {
-        if (observation.marker_id == id) views.push_back({&record, &observation.corners_px});
+        if (observation.marker_id == id) views.push_back({&record, &observation});
       }
     }
     if (views.size() < 2) continue;
@@ -196,7 +196,7 @@ int MarkerMapper::ReconsiderMappedMarkers() {
       for (const SeenBy& view : views) {
         const double rms = MarkerReprojectionRms(
             view.record->camera, view.record->cam_from_world * world_from_marker, corners,
-            *view.corners_px);
+            view.observation->corners_px);
         sum += std::min(rms * rms, kCapPx * kCapPx);
       }
       return sum;
@@ -206,12 +206,9 @@ int MarkerMapper::ReconsiderMappedMarkers() {
     std::optional<Rigid3> best;
     const std::size_t step = std::max<std::size_t>(1, views.size() / kMaxCandidateViews);
     for (std::size_t v = 0; v < views.size(); v += step) {
-      MarkerDetection detection;
-      detection.id = id.value;
-      detection.corners = *views[v].corners_px;
       const std::optional<MarkerPose> pose =
-          EstimateMarkerPose(detection, landmark.size, views[v].record->camera,
-                             options_.marker_pose);
+          EstimateMarkerPose(views[v].observation->AsDetection(), landmark.size,
+                             views[v].record->camera, options_.marker_pose);
       if (!pose) continue;
       const Rigid3 world_from_cam = views[v].record->cam_from_world.Inverse();
       for (int s = 0; s < pose->num_solutions; ++s) {
