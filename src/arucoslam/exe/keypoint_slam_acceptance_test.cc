@@ -1,4 +1,4 @@
-// Issue 5 acceptance on a short render: keypoint-only SLAM (`run --no-markers`) on a
+// Acceptance on a short render: keypoint-only SLAM (`run --no-markers`) on a
 // medium-texture factory whose first corner is made a tight turn (0.9 m radius); up to that
 // turn it must initialise within 2 s, pose >= 95% of the frames from initialisation on (on a
 // 10 s render the 2 s allowed for initialisation alone would be 20%), Sim(3) ATE <= 2% of

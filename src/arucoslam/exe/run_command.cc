@@ -23,6 +23,7 @@
 #include "arucoslam/io/config_file.h"
 #include "arucoslam/io/frame_source.h"
 #include "arucoslam/io/marker_map_json.h"
+#include "arucoslam/io/paced_source.h"
 #include "arucoslam/util/error.h"
 #include "arucoslam/util/files.h"
 
@@ -32,6 +33,7 @@ namespace {
 struct RunArgs {
   std::string dataset;
   std::string device;  // a live camera instead of a dataset
+  bool realtime = false;  // replay the dataset at its recorded rate, as a live camera
   std::size_t max_frames = 0;
   std::string out;
   std::string config;         // options file read over run's defaults
@@ -101,15 +103,20 @@ std::unique_ptr<FrameSource> OpenSource(const RunArgs& args) {
     throw InputError(args.image_topic.empty() ? "--camera-info-topic" : "--image-topic",
                      "only for a ROS bag (--dataset FILE.bag)");
   }
-  if (bag) {
-    return OpenBagSource(args.dataset,
-                         {args.image_topic, args.camera_info_topic, args.camera});
-  }
   if (args.device.empty()) {
-    DatasetOptions dataset_options;
-    dataset_options.camera_path = args.camera;
-    dataset_options.rate_hz = args.rate_hz;
-    return OpenFrameSource(args.dataset, dataset_options);
+    std::unique_ptr<FrameSource> recorded;
+    if (bag) {
+      recorded = OpenBagSource(args.dataset, {args.image_topic, args.camera_info_topic, args.camera});
+    } else {
+      DatasetOptions dataset_options;
+      dataset_options.camera_path = args.camera;
+      dataset_options.rate_hz = args.rate_hz;
+      recorded = OpenFrameSource(args.dataset, dataset_options);
+    }
+    if (!args.realtime) return recorded;
+    PacedSourceOptions paced;
+    paced.stop = &g_stop_requested;
+    return std::make_unique<PacedSource>(std::move(recorded), paced);
   }
   if (args.camera.empty()) {
     throw InputError("--device", "a live camera needs a camera calibration file (--camera)");
@@ -218,6 +225,10 @@ void AddRunCommand(CLI::App& app, int& exit_status) {
       "are dropped (stats.json frames.dropped)");
   dataset->excludes(device);
   device->excludes(dataset);
+  run->add_flag("--realtime", args->realtime,
+                "replay --dataset at its recorded rate, as the camera delivered it: frames the "
+                "SLAM has no time for are dropped (stats.json frames.dropped), as with --device")
+      ->excludes(device);
   run->add_option("--image-topic", args->image_topic,
                   "ROS bag: the image topic (sensor_msgs/Image or CompressedImage)");
   run->add_option("--camera-info-topic", args->camera_info_topic,

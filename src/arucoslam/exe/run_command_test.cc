@@ -77,6 +77,28 @@ TEST_F(RunCommandTest, RealStaticEurocSequenceWritesOutputsWithoutAMap) {
   EXPECT_NE(outcome.err.find("frame 95/95"), std::string::npos);  // the progress line
 }
 
+// --realtime replays the 95 frames (20 Hz, 4.7 s) as their camera delivered them: the run
+// lasts at least the recording, and every frame is either processed or counted as dropped.
+TEST_F(RunCommandTest, RealtimeReplayTakesTheRecordingsTimeAndCountsDroppedFrames) {
+  const fs::path data = fs::path(ARUCOSLAM_TEST_DATA_DIR) / "euroc_v101_micro";
+  if (!fs::exists(data)) GTEST_SKIP() << "test data missing: " << data;
+  const fs::path out = dir_ / "out";
+  const Outcome outcome =
+      Run("run --dataset " + data.string() + " --out " + out.string() + " --realtime --quiet");
+  ASSERT_EQ(outcome.status, 0) << outcome.err;
+  const std::string stats = ReadTextFile(out / "stats.json");
+  const auto number_after = [&stats](const std::string& key) {
+    const std::size_t at = stats.find("\"" + key + "\": ");
+    EXPECT_NE(at, std::string::npos) << key;
+    return at == std::string::npos ? -1.0 : std::atof(stats.c_str() + at + key.size() + 4);
+  };
+  EXPECT_EQ(number_after("total") + number_after("dropped"), 95.0) << stats;
+  EXPECT_GE(number_after("total"), 1.0);
+  EXPECT_GE(number_after("wall_time_s"), 4.7);
+  EXPECT_EQ(Run("run --dataset " + data.string() + " --device 0 --realtime --out " +
+                (dir_ / "x").string()).status, 2);
+}
+
 // An image folder of a textured plane 2 m in front of a camera sliding sideways (images
 // made by warping a real EuRoC frame with the plane's homography), with its calibration.
 fs::path MakePlaneSequence(const fs::path& dir, int num_frames) {

@@ -97,7 +97,7 @@ double Median(std::vector<double> values) {
   return values[values.size() / 2];
 }
 
-// Issue 2 acceptance: one 0.2 m marker, 0.5..4 m, camera position error median <= 1% of
+// Acceptance: one 0.2 m marker, 0.5..4 m, camera position error median <= 1% of
 // the distance; a view whose pose is off by more than 5% or 10 degrees must be flagged.
 TEST(CameraLocatorTest, OneMarkerPositionErrorWithinOnePercentOfDistance) {
   std::mt19937 rng(7);

@@ -95,7 +95,7 @@ Scene RandomScene(int index, std::mt19937& rng) {
   return scene;
 }
 
-// Issue 2 acceptance: recall >= 99% for a 0.2 m marker up to 4 m, 640x480, fx 500, tilted
+// Acceptance: recall >= 99% for a 0.2 m marker up to 4 m, 640x480, fx 500, tilted
 // up to 40 degrees; 50 degrees is measured apart (at 4 m the marker is then 25 x 16 px,
 // under 3 px per cell across). Measured with the default options: 287/288 up to 40 degrees,
 // 90/96 at 50; with rescue_rejected: 288/288 and 94/96 (91/96 before the rescue fitted

@@ -113,7 +113,7 @@ Eigen::Matrix3d RotationFromRpy(double roll, double pitch, double yaw) {
 // Real photo 403.jpg (github.com/UbiquityRobotics/fiducials, auto_init_403 test): marker 403
 // (0.145 m) seen by a Raspberry Pi camera mounted on the robot; the peer places the marker
 // at xyz (0.7611, 0.2505, 0.4028) m, rpy (1.5751, -0.014, -1.546) rad in base_link. Ours:
-// within 1 cm and 1 degree (issue 2).
+// within 1 cm and 1 degree.
 TEST(MarkerPoseRealTest, Image403MarkerPoseMatchesPeer) {
   const std::filesystem::path dir =
       std::filesystem::path(ARUCOSLAM_TEST_DATA_DIR) / "fiducials_aruco_unit";

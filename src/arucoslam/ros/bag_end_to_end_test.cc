@@ -405,7 +405,7 @@ TEST_F(BagEndToEndTest, NodePublishesTfPosesInTheMarkerWorld) {
     EXPECT_GE(node_matched, online_matched * 9 / 10);
     // A tf pose is the estimate when its frame was tracked; the run's trajectory has the
     // end-of-run adjustments (whole-map marker BA, frame refinement) and every realignment
-    // after it. Issue 30 asks for the node within 0.01 m of the run on the same frames; measured
+    // after it. The node is wanted within 0.01 m of the run on the same frames; measured
     // (BENCHMARKS.md, "ROS node"): node 0.059 or 0.067 m, the run 0.053 m on the same frames, its
     // online poses 0.059 m. The node's own timing (when the mapping thread finishes a keyframe)
     // makes the second figure: within 0.02 m is what holds, not 0.01 m.
