@@ -32,19 +32,19 @@ struct MarkerFusionOptions {
   // pose (the aligned tracker's motion model, else constant velocity from the recent marker
   // fixes) settles it (ResolveAmbiguity, within ambiguity_gates).
   bool resolve_ambiguity_by_motion = true;
-  AmbiguityPriorGates ambiguity_gates;
-  WorldMotionPriorOptions fix_motion;
+  AmbiguityPriorGates ambiguity_gates;  // how near a prediction the settled solution lies
+  WorldMotionPriorOptions fix_motion;   // the constant-velocity prediction from the fixes
   // Before the map is aligned: the ambiguous one-marker views it tracked vote for the
   // world's orientation relative to the map (world_rotation_vote.h); once they agree, the
   // map's predicted orientation of a frame settles its ambiguous marker (rotation gate of
   // map_rotation_gates).
   bool resolve_ambiguity_by_map_rotation = true;
-  WorldRotationVoteOptions rotation_vote;
-  AmbiguityPriorGates map_rotation_gates{.max_rotation_deg = 6.0};
+  WorldRotationVoteOptions rotation_vote;                           // that vote
+  AmbiguityPriorGates map_rotation_gates{.max_rotation_deg = 6.0};  // its rotation gate
   // Else the markers the known map lacks, seen with the ambiguous one, vote: only the true
   // camera poses of two viewpoints put them at the same world points (covisible_marker_vote.h).
   bool resolve_ambiguity_by_covisible_markers = true;
-  CovisibleMarkerVoteOptions covisible_vote;
+  CovisibleMarkerVoteOptions covisible_vote;  // that vote
   // World-aligned map: a keypoint pose whose camera centre lies farther than this (metres)
   // from the same frame's marker location is wrong (a look-alike place), and a pose found
   // by relocalisation is confirmed only when it lies this close.

@@ -96,8 +96,8 @@ Rigid3 Shifted(const Rigid3& world_from_cam, double dx) {
 }
 
 // Marker 0 alone seen from `world_from_cam` (3 m away, 20 sides, 20 degrees off its normal:
-// IPPE's two solutions explain its corners about as well) and that true pose; its other
-// solution lies about 40 degrees and 2 m from the truth.
+// IPPE's two solutions explain its corners about as well) and that true pose; the view is
+// kept when its location is ambiguous between solutions more than 10 degrees apart.
 struct AmbiguousView {
   Rigid3 world_from_cam;
   std::vector<MarkerDetection> detections;
@@ -194,8 +194,8 @@ TEST(MarkerFusionTest, AmbiguousMarkerIsSettledByTheAlignedTrackersPrediction) {
   const std::optional<MarkerFix>& fix = fusion.Locate(view.detections, Board(), 0.0, map, 0);
   ASSERT_TRUE(fix);
   EXPECT_TRUE(fix->settled_ambiguity);
-  // The true solution: one marker 3 m away still leaves it about 10 cm off (the other
-  // solution is 2 m off).
+  // The true solution, within what one marker 20 sides away allows (the mirrored one lies
+  // metres away).
   EXPECT_LT((fix->world_from_cam.translation - view.world_from_cam.translation).norm(), 0.2);
   EXPECT_LT(Degrees(fix->world_from_cam.rotation, view.world_from_cam.rotation), 3.0);
   EXPECT_EQ(fusion.stats().num_disambiguations, 1);
