@@ -54,23 +54,9 @@ void VisitOptions(SystemOptions& o, Visitor& visit) {
         "lost with at most this many keyframes: the map is discarded and initialised again");
   visit("detector", o.detector, "marker detection (with a marker map)");
   visit("marker_search", o.marker_search, "where each image's markers are searched");
-  visit("locator", o.locator, "camera pose from the markers (LocateCamera)");
+  visit("marker_fusion", o.marker_fusion,
+        "each frame's marker location and the verdict on keypoint poses against it");
   visit("alignment", o.alignment, "keypoint map to marker world alignment (Sim3)");
-  visit("max_marker_rms_px", o.max_marker_rms_px,
-        "a marker location is used with a corner RMS at most this, pixels");
-  visit("max_marker_distance_sides", o.max_marker_distance_sides,
-        "... and its nearest marker at most this many marker sides away");
-  visit("resolve_ambiguity_by_motion", o.resolve_ambiguity_by_motion,
-        "an ambiguous one-marker location settled by a motion prediction");
-  visit("ambiguity_gates", o.ambiguity_gates, "gates of that prediction");
-  visit("fix_motion", o.fix_motion, "constant-velocity prediction from recent marker fixes");
-  visit("resolve_ambiguity_by_map_rotation", o.resolve_ambiguity_by_map_rotation,
-        "unaligned map: ambiguous markers settled by the map's voted world orientation");
-  visit("rotation_vote", o.rotation_vote, "that vote");
-  visit("map_rotation_gates", o.map_rotation_gates, "gates of the voted orientation");
-  visit("resolve_ambiguity_by_covisible_markers", o.resolve_ambiguity_by_covisible_markers,
-        "else: ambiguous markers settled by the unknown markers seen with them");
-  visit("covisible_vote", o.covisible_vote, "that vote");
   visit("relocate_marker_poses", o.relocate_marker_poses,
         "at the end, with mapped markers: frames located again in the final marker map");
   visit("min_alignment_anchors", o.min_alignment_anchors,
@@ -87,16 +73,6 @@ void VisitOptions(SystemOptions& o, Visitor& visit) {
         "before alignment a frame with a marker location becomes a keyframe after this many");
   visit("marker_reset_lost_frames", o.marker_reset_lost_frames,
         "aligned map lost this many frames while markers give poses: a new map");
-  visit("max_marker_disagreement_m", o.max_marker_disagreement_m,
-        "a keypoint pose farther than this from the frame's marker location is wrong, metres");
-  visit("correct_drift_beyond_gate", o.correct_drift_beyond_gate,
-        "such a disagreement after steady tracking is drift, corrected with the markers");
-  visit("min_drift_interval_s", o.min_drift_interval_s,
-        "drift when tracked without a break this long since the markers agreed, seconds");
-  visit("max_drift_step_m", o.max_drift_step_m,
-        "sooner: drift only when the disagreement grew at most this since the last, metres");
-  visit("max_drift_correction_frames", o.max_drift_correction_frames,
-        "frames that wait for a drift correction");
   visit("markers_in_local_ba", o.markers_in_local_ba,
         "aligned map: marker observations in local and global BA");
   visit("map_unknown_markers", o.map_unknown_markers, "aligned map: map markers it lacks");

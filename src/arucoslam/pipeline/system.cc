@@ -19,6 +19,13 @@ void WaitIgnoringErrors(MarkerDetectorWorker& worker) {
   }
 }
 
+MarkerFusion MakeMarkerFusion(const SystemOptions& options, const CameraModel& camera) {
+  if (!options.marker_map) return MarkerFusion(options.marker_fusion, camera, MarkerMap(), 0.0);
+  const double unknown_size =
+      UnknownMarkerSize(*options.marker_map, options.marker_mapping.unknown_marker_size_m);
+  return MarkerFusion(options.marker_fusion, camera, *options.marker_map, unknown_size);
+}
+
 }  // namespace
 
 bool SystemOptions::Check(std::string* why) const {
@@ -35,12 +42,8 @@ bool SystemOptions::Check(std::string* why) const {
   check.Nested("pose_consistency", pose_consistency);
   check.AtLeast("synchronous_young_map_keyframes", synchronous_young_map_keyframes, 0);
   check.Nested("detector", detector);
-  check.Nested("locator", locator);
+  check.Nested("marker_fusion", marker_fusion);
   check.Nested("alignment", alignment);
-  check.Above("max_marker_rms_px", max_marker_rms_px, 0.0);
-  check.Above("max_marker_distance_sides", max_marker_distance_sides, 0.0);
-  check.Nested("ambiguity_gates", ambiguity_gates);
-  check.Nested("fix_motion", fix_motion);
   check.AtLeast("min_alignment_anchors", min_alignment_anchors, 2);
   check.AtLeast("min_alignment_baseline_m", min_alignment_baseline_m, 0.0);
   check.Above("max_alignment_rms_m", max_alignment_rms_m, 0.0);
@@ -49,19 +52,12 @@ bool SystemOptions::Check(std::string* why) const {
   check.AtLeast("max_realignment_anchors", max_realignment_anchors, min_alignment_anchors,
                 "min_alignment_anchors");
   check.Nested("places", places);
-  check.Above("max_marker_disagreement_m", max_marker_disagreement_m, 0.0);
-  check.AtLeast("min_drift_interval_s", min_drift_interval_s, 0.0);
-  check.AtLeast("max_drift_correction_frames", max_drift_correction_frames, 1);
-  check.AtLeast("max_drift_step_m", max_drift_step_m, 0.0);
   check.AtLeast("min_frames_between_anchor_keyframes", min_frames_between_anchor_keyframes, 0);
   check.Nested("marker_mapping", marker_mapping);
   check.Above("new_map_after_lost_s", new_map_after_lost_s, 0.0);
   check.Above("min_marker_init_baseline_m", min_marker_init_baseline_m, 0.0);
   check.AtLeast("min_marker_init_parallax_deg", min_marker_init_parallax_deg, 0.0);
   check.Nested("marker_search", marker_search);
-  check.Nested("rotation_vote", rotation_vote);
-  check.Nested("covisible_vote", covisible_vote);
-  check.Nested("map_rotation_gates", map_rotation_gates);
   check.InRange("refine_min_inlier_fraction", refine_min_inlier_fraction, 0.0, 1.0,
                 Interval::kOpenClosed);
   check.Nested("bridge_motion", bridge_motion);
@@ -77,7 +73,8 @@ System::System(const CameraModel& camera, const SystemOptions& options)
     : camera_(camera),
       options_(options),
       extractor_(options.extractor),
-      initializer_(options.initializer) {
+      initializer_(options.initializer),
+      marker_fusion_(MakeMarkerFusion(options, camera)) {
   if (std::string why; !options_.Check(&why)) {
     throw std::invalid_argument("System: invalid SystemOptions: " + why);
   }
@@ -242,7 +239,8 @@ FrameReport System::ProcessFrame(Frame frame, const std::vector<MarkerDetection>
   report.timestamp_s = frame.timestamp_s;
   report.num_features = static_cast<int>(frame.features.size());
   if (frame.map_point_ids.size() != frame.features.size()) frame.ResetMatches();
-  fix_ = LocateWithMarkers(frame, detections, report);
+  LocateWithMarkers(frame, detections, report);
+  const std::optional<MarkerFix>& fix = marker_fusion_.fix();
   if (tracker_->state() == TrackingState::kNotInitialized) {
     map_loaded_ ? LocalizeInLoadedMap(frame, report) : Initialize(frame, report);
   } else {
@@ -250,16 +248,16 @@ FrameReport System::ProcessFrame(Frame frame, const std::vector<MarkerDetection>
   }
   // A loaded map that stays outside the marker world takes no marker-only poses.
   const bool marker_poses = world_aligned_ || !localize_only_;
-  if (!report.cam_from_world && fix_ && marker_poses) RecordMarkerPose(frame, report);
+  if (!report.cam_from_world && fix && marker_poses) RecordMarkerPose(frame, report);
   if (!localize_only_) FeedMarkerView(frame);
   // Without a world pose now (none, or a keypoint pose outside the world without a marker
   // location), a frame that saw markers may be located at the end.
-  const bool world_pose = report.cam_from_world && (world_aligned_ || fix_);
+  const bool world_pose = report.cam_from_world && (world_aligned_ || fix);
   if (!world_pose && !frame.markers.empty()) {
     unposed_marker_frames_.push_back({frame.timestamp_s, frame.markers});
   }
   report.world_aligned = world_aligned_;
-  if (fix_) report.marker_world_from_cam = fix_->world_from_cam;
+  if (fix) report.marker_world_from_cam = fix->world_from_cam;
   const bool in_world = !options_.marker_map || world_aligned_ || report.marker_pose;
   if (report.cam_from_world && in_world) {
     report.online_world_from_cam = report.cam_from_world->Inverse();
@@ -273,6 +271,7 @@ FrameReport System::ProcessFrame(Frame frame, const std::vector<MarkerDetection>
       unposed_without_markers_s_.push_back(frame.timestamp_s);
     }
     stats_.tracking_ms.Add(watch.ElapsedMilliseconds());
+    stats_.marker_fusion = marker_fusion_.stats();
   }
   if (pending_keyframe_) {
     MapKeyframe(*pending_keyframe_);
@@ -289,7 +288,7 @@ void System::Initialize(Frame& frame, FrameReport& report) {
     if (enough) {
       KeepForBackfill();
       init_reference_ = frame;
-      init_reference_fix_ = fix_;
+      init_reference_fix_ = marker_fusion_.fix();
     }
     report.message = enough ? "initialisation reference" : "too few features";
     return;
@@ -309,7 +308,7 @@ void System::Initialize(Frame& frame, FrameReport& report) {
     if (result.failure == InitFailure::kTooFewMatches && enough) {
       KeepForBackfill();
       init_reference_ = frame;
-      init_reference_fix_ = fix_;
+      init_reference_fix_ = marker_fusion_.fix();
     } else {
       KeepForBackfill(frame);
     }
@@ -347,9 +346,9 @@ void System::FinishInitialization(Frame& first, Frame& frame, KeyframeId first_i
   }
   AddBridgePrior(first_id, first.timestamp_s);
   AddAnchor(first_id, init_reference_fix_);
-  AddAnchor(second_id, fix_);
+  AddAnchor(second_id, marker_fusion_.fix());
   init_reference_fix_.reset();
-  MaybeAlignWorld(&frame);
+  MaybeAlignWorld(frame);
   frames_since_keyframe_ = 0;
   last_state_ = TrackingState::kTracking;
   report.state = TrackingState::kTracking;
@@ -366,16 +365,14 @@ void System::FinishInitialization(Frame& first, Frame& frame, KeyframeId first_i
 void System::Track(Frame& frame, FrameReport& report) {
   static const std::vector<MarkerPoseObservation> kNoMarkers;
   FollowMapCorrections();
-  TrackingResult result = tracker_->Track(frame, world_aligned_ && fix_ ? fix_->markers : kNoMarkers);
+  const std::optional<MarkerFix>& fix = marker_fusion_.fix();
+  TrackingResult result = tracker_->Track(frame, world_aligned_ && fix ? fix->markers : kNoMarkers);
   if (result.state == TrackingState::kTracking && frame.cam_from_world &&
-      DisagreesWithMarkers(*frame.cam_from_world) && !TakeDisagreementAsDrift(frame, report)) {
-    ARUCOSLAM_LOG_DEBUG("frame {}: keypoint pose {:.2f} m from the markers' location, rejected",
-                        report.index, MarkerOffset(*frame.cam_from_world).norm());
+      marker_fusion_.JudgeTrackedPose(frame, world_aligned_, report.index) ==
+          PoseVerdict::kRejected) {
     tracker_->MarkLost();
     frame.cam_from_world.reset();
     result.state = TrackingState::kLost;
-    std::lock_guard lock(stats_mutex_);
-    ++stats_.num_marker_disagreements;
   }
   bool relocalized = false;
   if (result.state != TrackingState::kTracking &&
@@ -398,7 +395,7 @@ void System::Track(Frame& frame, FrameReport& report) {
                         map_->NumKeyframes());
     // A map aligned to the world is kept (markers relocalise into it) unless marker poses
     // keep coming and it does not take them back.
-    const bool stuck = fix_ && ++lost_with_markers_ >= options_.marker_reset_lost_frames;
+    const bool stuck = fix && ++lost_with_markers_ >= options_.marker_reset_lost_frames;
     const bool young = static_cast<int>(map_->NumKeyframes()) <= options_.reset_max_keyframes;
     if (map_loaded_) return;  // a loaded map is kept: frames relocalise into it
     KeepLostFrame(frame);
@@ -417,8 +414,7 @@ void System::Track(Frame& frame, FrameReport& report) {
   }
   last_state_ = TrackingState::kTracking;
   lost_frames_.clear();
-  NoteMarkerAgreement(frame, relocalized);
-  VoteForWorldRotation(frame);
+  marker_fusion_.NoteTrackedFrame(frame, relocalized, world_aligned_);
   lost_with_markers_ = 0;
   lost_since_s_.reset();
   ++frames_since_keyframe_;
@@ -442,14 +438,14 @@ void System::MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& rep
   // A frame with a usable marker location becomes a keyframe sooner until the map is first
   // aligned (anchors are kept on keyframes only).
   const bool wants_anchor =
-      fix_ && !world_aligned_ &&
+      marker_fusion_.fix() && !world_aligned_ &&
       frames_since_keyframe_ >= options_.min_frames_between_anchor_keyframes &&
       num_inliers > options_.keyframes.min_tracked_points && input.mapper_has_room;
-  const bool wants_drift_keyframe = drift_keyframe_wanted_ && input.mapper_has_room;
+  const bool wants_drift_keyframe = marker_fusion_.drift_keyframe_wanted() && input.mapper_has_room;
   if (!wants_anchor && !wants_drift_keyframe && !DecideKeyframe(options_.keyframes, input).insert) {
     return;
   }
-  drift_keyframe_wanted_ = false;
+  marker_fusion_.KeyframeInserted();
   const KeyframeId keyframe = InsertKeyframe(*map_, frame, tracker_->reference_keyframe());
   tracker_->SetReferenceKeyframe(keyframe);
   frames_since_keyframe_ = 0;
@@ -460,7 +456,7 @@ void System::MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& rep
   }
   // The marker location is stored before the keyframe is queued: the mapping thread's drift
   // correction reads it.
-  AddAnchor(keyframe, fix_);
+  AddAnchor(keyframe, marker_fusion_.fix());
   if (options_.blocking) {
     pending_keyframe_ = keyframe;  // mapped once the frame's tracking time is recorded
   } else {
@@ -476,7 +472,7 @@ void System::MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& rep
       }
     }
   }
-  MaybeAlignWorld(&frame);
+  MaybeAlignWorld(frame);
 }
 
 void System::RecordPose(const Frame& frame, KeyframeId reference) {
@@ -485,8 +481,9 @@ void System::RecordPose(const Frame& frame, KeyframeId reference) {
   pose.reference = reference;
   pose.cam_from_world = *frame.cam_from_world;
   pose.in_world = world_aligned_;
-  if (!world_aligned_ && fix_) {
-    pose.marker_cam_from_world = fix_->world_from_cam.Inverse();
+  const std::optional<MarkerFix>& fix = marker_fusion_.fix();
+  if (!world_aligned_ && fix) {
+    pose.marker_cam_from_world = fix->world_from_cam.Inverse();
     pose.seen_markers = frame.markers;
   }
   const std::optional<Rigid3> reference_pose = map_->Read([&](const MapData& data) {
@@ -506,7 +503,7 @@ void System::RecordPose(const Frame& frame, KeyframeId reference) {
       pose.matches.push_back({frame.map_point_ids[i], frame.UndistortedPixel(index).cast<float>(),
                               static_cast<float>(frame.SigmaPx(index))});
     }
-    if (world_aligned_ && fix_ && fix_->known_markers_only) pose.markers = fix_->markers;
+    if (world_aligned_ && fix && fix->known_markers_only) pose.markers = fix->markers;
   }
   poses_.push_back(std::move(pose));
 }
@@ -563,14 +560,12 @@ void System::ResetMap() {
   }
   next_alignment_anchors_ = 0;
   world_aligned_ = false;
-  rotation_vote_.Clear();
-  covisible_vote_.Clear();
+  marker_fusion_.MapReset();
   absorbed_keyframes_.clear();
   bridge_priors_.clear();
   bridge_adjustment_priors_.clear();
   lost_with_markers_ = 0;
   lost_since_s_.reset();
-  ForgetMarkerAgreement();
   last_state_ = TrackingState::kNotInitialized;
   mapping_busy_ = false;
   StartMappingThread();

@@ -34,11 +34,10 @@
 #include "arucoslam/slam/keyframe_policy.h"
 #include "arucoslam/slam/local_mapper.h"
 #include "arucoslam/slam/map_initialization.h"
+#include "arucoslam/slam/marker_fusion.h"
 #include "arucoslam/slam/marker_mapper.h"
 #include "arucoslam/slam/tracker.h"
 #include "arucoslam/slam/world_alignment.h"
-#include "arucoslam/slam/covisible_marker_vote.h"
-#include "arucoslam/slam/world_rotation_vote.h"
 #include "arucoslam/util/timing.h"
 
 namespace arucoslam {
@@ -96,36 +95,15 @@ struct SystemOptions {
   // are found at the whole-image searches, then followed. full_scan_interval 1: always the
   // whole image.
   MarkerSearchOptions marker_search;
-  CameraLocatorOptions locator;
+  // Each frame's marker location, its ambiguity, and the verdict on keypoint poses that
+  // contradict it (drift to correct, or a look-alike place).
+  MarkerFusionOptions marker_fusion;
   // Anchor outliers beyond 0.25 m: a single marker's pose at a few metres can be off by more
   // than WorldAlignmentOptions' 0.10 m default allows.
   WorldAlignmentOptions alignment{0.0, 0.25, 0.05};
-  // A marker location is used only when it is not ambiguous (several markers, or one whose
-  // IPPE solutions are well separated) and its corner RMS is at most this, pixels.
-  double max_marker_rms_px = 2.0;
-  // ... and when its nearest marker is at most this many marker sides from the camera: a
-  // location's error grows with the square of the distance.
-  double max_marker_distance_sides = 25.0;
-  // An ambiguous one-marker location is still used when a prediction of the frame's world
-  // pose (the aligned tracker's motion model, else constant velocity from the recent marker
-  // fixes) settles it: system_markers.cc, ResolveAmbiguity.
-  bool resolve_ambiguity_by_motion = true;
-  AmbiguityPriorGates ambiguity_gates;
-  WorldMotionPriorOptions fix_motion;
-  // Before the map is aligned: the ambiguous one-marker views it tracked vote for the
-  // world's orientation relative to the map (world_rotation_vote.h); once they agree, the
-  // map's predicted orientation of a frame settles its ambiguous marker (rotation gate of
-  // map_rotation_gates).
-  bool resolve_ambiguity_by_map_rotation = true;
-  WorldRotationVoteOptions rotation_vote;
-  AmbiguityPriorGates map_rotation_gates{.max_rotation_deg = 6.0};
-  // Else the markers the known map lacks, seen with the ambiguous one, vote: only the true
-  // camera poses of two viewpoints put them at the same world points (covisible_marker_vote.h).
-  bool resolve_ambiguity_by_covisible_markers = true;
   // At Finish, when markers were mapped: frames posed by markers are located again in the
   // final marker map, and frames that saw markers but got no pose are located in it.
   bool relocate_marker_poses = true;
-  CovisibleMarkerVoteOptions covisible_vote;
   // World alignment waits for this many keyframes with a usable marker location whose
   // camera centres span at least min_alignment_baseline_m (metres); it is refused when the
   // anchors' residual after alignment exceeds max_alignment_rms_m (metres).
@@ -146,24 +124,6 @@ struct SystemOptions {
   // the map does not take them back: the map is discarded and a new one initialised and
   // aligned (the poses already output are kept).
   int marker_reset_lost_frames = 10;
-  // World-aligned map: a keypoint pose whose camera centre lies farther than this (metres)
-  // from the same frame's marker location is wrong (a look-alike place): tracking counts as
-  // lost and restarts from the markers. A place-database relocalisation is accepted only when
-  // a marker location of the frame agrees with it this closely.
-  double max_marker_disagreement_m = 0.5;
-  // Drift, not a look-alike place: a disagreement is taken as drift when the map has been
-  // tracked without a break (no relocalisation the markers did not confirm, no new map) for
-  // at least min_drift_interval_s since its markers last agreed with it. The frame keeps
-  // its keypoint pose and becomes a keyframe whose marker location corrects the whole map
-  // (CorrectDriftWithMarkers); the next max_drift_correction_frames frames wait for that
-  // correction, after which a disagreement is a look-alike place again. Sooner after the
-  // markers agreed, a disagreement is drift only if it grew by at most max_drift_step_m
-  // since the previous frame with a marker location: the map does not drift half a metre
-  // at once.
-  bool correct_drift_beyond_gate = true;
-  double min_drift_interval_s = 2.0;
-  double max_drift_step_m = 0.25;  // growth of the disagreement since the last marker frame
-  int max_drift_correction_frames = 15;
   // Once the map is world-aligned, keyframes' marker observations join local BA and the
   // global BA after a loop (known markers fixed) and markers the map lacks are mapped
   // (system_marker_mapping.cc).
@@ -322,17 +282,12 @@ struct SystemStats {
   // extraction; the time from extraction's end until detections are ready) plus location.
   TimingStats marker_wait_ms;
   int num_full_marker_scans = 0;  // frames whose markers were searched in the whole image
-  int num_marker_frames = 0;      // frames with a usable marker location
-  int num_marker_disambiguations = 0;  // ... of which one ambiguous marker settled by motion
+  MarkerFusionStats marker_fusion;     // marker locations and verdicts on keypoint poses
   int num_relocated_marker_poses = 0;  // marker poses located again in the final marker map
   int num_late_marker_poses = 0;       // frames without a pose located in it at the end
-  int num_covisible_disambiguations = 0;  // ... by markers seen with it (CovisibleMarkerVote)
-  int num_map_rotation_disambiguations = 0;  // ... by the unaligned map's voted orientation
   int num_marker_only_poses = 0;  // frames whose pose came from markers alone
   int num_world_alignments = 0;
   int num_marker_relocalizations = 0;  // tracking restarted from a marker pose
-  int num_marker_disagreements = 0;    // keypoint poses rejected by the markers
-  int num_drift_disagreements = 0;     // ... kept instead as drift to correct (first frames)
   int num_map_relocalizations = 0;     // loaded map: restarted from a keyframe match
   PlaceRecognitionStats places;        // relocalisation and loops (with a vocabulary)
   int num_new_maps_after_loss = 0;     // maps started because tracking stayed lost
@@ -423,53 +378,18 @@ class System {
     KeyframeId keyframe;
     Rigid3 world_from_cam;
   };
-  struct MarkerFix {  // a usable marker location of the current frame
-    Rigid3 world_from_cam;
-    std::vector<MarkerPoseObservation> markers;  // its inlier markers, undistorted corners
-    double nearest_marker_sides = 0.0;           // camera to its nearest marker, in sides
-    bool known_markers_only = true;  // located by markers.json's fixed markers alone
-    bool disambiguated_by_motion = false;  // one ambiguous marker, settled by the prediction
-  };
 
   void Initialize(Frame& frame, FrameReport& report);
   void Track(Frame& frame, FrameReport& report);
-  // Marker handling (system_markers.cc).
-  std::optional<MarkerFix> LocateWithMarkers(Frame& frame,
-                                             const std::vector<MarkerDetection>& detections,
-                                             FrameReport& report);
+  // Marker handling (system_markers.cc): the frame's markers and their location
+  // (marker_fusion_), with a marker map only.
+  void LocateWithMarkers(Frame& frame, const std::vector<MarkerDetection>& detections,
+                         FrameReport& report);
   bool RelocalizeWithMarkers(Frame& frame, FrameReport& report);
-  // The solution of an ambiguous one-marker location that the motion predictions settle on.
-  // `by_map_rotation`: settled by the unaligned map's voted orientation alone.
-  // The detections of markers absent from the locating map, and their side (metres).
-  // Whether a found location (its IPPE alternative when `alternative`) fits its corners
-  // within max_marker_rms_px with its nearest marker within max_marker_distance_sides
-  // (returned in `nearest_sides`).
-  bool UsableLocation(const CameraLocation& location, bool alternative, const MarkerMap& known,
-                      double* nearest_sides) const;
   // Finish, when markers were mapped: the frames posed by markers are located again in the
   // final marker map, and the frames that saw markers but got no pose are located in it
   // (system_marker_relocation.cc).
   void RelocateMarkerPoses();
-  std::optional<Rigid3> LocateInFinalMap(const std::vector<MarkerObservation>& markers,
-                                         const MarkerMap& final_map,
-                                         const std::optional<Rigid3>& previous) const;
-  // The detections of markers absent from the locating map.
-  std::vector<MarkerDetection> UnknownDetections(
-      const CameraLocation& location, const std::vector<MarkerDetection>& detections) const;
-  AmbiguityChoice ResolveByMotion(const CameraLocation& location, double timestamp_s,
-                                  bool* by_map_rotation) const;
-  // The frame's marker location minus the camera centre of `cam_from_world` (needs fix_).
-  Eigen::Vector3d MarkerOffset(const Rigid3& cam_from_world) const;
-  // True when the frame's marker location (world-aligned map) contradicts the pose.
-  bool DisagreesWithMarkers(const Rigid3& cam_from_world) const;
-  // A tracked frame whose pose the markers contradict: true when the contradiction is
-  // drift to correct (correct_drift_beyond_gate); the frame then becomes a keyframe.
-  bool TakeDisagreementAsDrift(const Frame& frame, FrameReport& report);
-  // After a tracked or relocalised frame: whether its markers agreed with the pose
-  // (`relocalized`: a relocalisation they did not confirm breaks the tracking's continuity).
-  void NoteMarkerAgreement(const Frame& frame, bool relocalized);
-  // Ends the tracking's continuity with its markers (and any drift being corrected).
-  void ForgetMarkerAgreement();
   // Map reuse (system_map_reuse.cc): a frame before the first localisation in a loaded map,
   // and the keyframe-seeded relocalisation (brute-force matching against a few keyframes
   // per frame, pose-only optimisation, then TrackFromPose).
@@ -479,7 +399,7 @@ class System {
   void AddAnchor(KeyframeId keyframe, const std::optional<MarkerFix>& fix);
   // Aligns the map to the world once enough anchors exist; `frame` (the current one, its
   // pose in the map) is carried along.
-  void MaybeAlignWorld(Frame* frame);
+  void MaybeAlignWorld(Frame& frame);
   void RecordMarkerPose(const Frame& frame, FrameReport& report);
   // Place recognition (system_places.cc).
   void MakePlaceRecognition();
@@ -584,15 +504,9 @@ class System {
   std::optional<std::vector<cv::Rect>> MarkerSearchRegions();
   void RememberMarkerView(const FrameReport& report,
                           const std::vector<MarkerDetection>& detections);
-  std::optional<MarkerFix> fix_;               // the current frame's
+  // The current frame's marker location (fix()) and the state it is judged with.
+  MarkerFusion marker_fusion_;
   std::optional<MarkerFix> init_reference_fix_;
-  WorldMotionPrior fix_motion_{options_.fix_motion};  // the recent fixes' world poses
-  // Unaligned map: the orientation votes of its ambiguous marker views, and the current
-  // frame's ambiguous location (voted once the frame is tracked).
-  WorldRotationVote rotation_vote_{options_.rotation_vote};
-  CovisibleMarkerVote covisible_vote_{options_.covisible_vote};
-  std::optional<CameraLocation> ambiguous_location_;
-  void VoteForWorldRotation(const Frame& frame);
   std::vector<MarkerAnchor> anchors_;
   bool world_aligned_ = false;
   // Until the map is aligned, keyframes that saw a marker are not culled: they carry the
@@ -604,13 +518,6 @@ class System {
   void MakeLocalMapper();
   int next_alignment_anchors_ = 0;  // alignment is tried again at this many anchors
   int lost_with_markers_ = 0;
-  // Timestamp of the last frame whose marker location agreed with its keypoint pose, the map
-  // tracked without a break since (nullopt: not aligned, or broken since); frames kept as
-  // drift since the first one, waiting for the correction; a keyframe wanted for it.
-  std::optional<double> markers_agreed_s_;
-  std::optional<Eigen::Vector3d> last_marker_offset_;  // MarkerOffset at the last fix
-  int drift_frames_ = 0;
-  bool drift_keyframe_wanted_ = false;
   std::optional<double> lost_since_s_;  // timestamp of the first lost frame of this loss
   // Closed maps: keypoints only, the biggest one's poses; with markers, the aligned ones'
   // keyframes and points (their poses stay in poses_, frozen).

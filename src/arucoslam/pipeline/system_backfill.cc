@@ -27,7 +27,7 @@ void System::KeepForBackfill(const std::optional<Frame>& frame) {
 
 void System::KeepLostFrame(const Frame& frame) {
   // A frame the markers posed keeps that pose (in the world, whatever the next map does).
-  if (!fix_) KeepAtMost(options_.max_backfill_frames, frame, &lost_frames_);
+  if (!marker_fusion_.fix()) KeepAtMost(options_.max_backfill_frames, frame, &lost_frames_);
 }
 
 void System::BackfillInitialization(const Frame& second, KeyframeId first_id,

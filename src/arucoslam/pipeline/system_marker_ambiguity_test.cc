@@ -102,7 +102,8 @@ AmbiguityRun RunClip(int first, const Eigen::Vector3d& offset = Eigen::Vector3d:
     const std::vector<MarkerDetection> detections = Detect(map, ids, world_from_cam, rng);
     if (ids.size() == 1) {
       run.ambiguous_frames +=
-          LocateCamera(detections, map, SceneCamera(), options.locator).quality.ambiguous;
+          LocateCamera(detections, map, SceneCamera(), options.marker_fusion.locator)
+              .quality.ambiguous;
     }
     system.ProcessFrame(std::move(frame), detections);
   }
@@ -116,8 +117,8 @@ TEST(SystemMarkerAmbiguity, MotionFromEarlierFixesSettlesTheAmbiguousMarker) {
   const AmbiguityRun run = RunClip(0);
   // The one-marker views are ambiguous (most of them; each is counted independently).
   EXPECT_GE(run.ambiguous_frames, 15);
-  EXPECT_EQ(run.stats.num_marker_disambiguations, run.ambiguous_frames);
-  EXPECT_EQ(run.stats.num_marker_frames, kNumFrames);
+  EXPECT_EQ(run.stats.marker_fusion.num_disambiguations, run.ambiguous_frames);
+  EXPECT_EQ(run.stats.marker_fusion.num_located_frames, kNumFrames);
   ASSERT_EQ(static_cast<int>(run.trajectory.size()), kNumFrames);
   double worst_position = 0.0, worst_rotation_deg = 0.0;
   for (const StampedPose& pose : run.trajectory) {
@@ -139,10 +140,10 @@ TEST(SystemMarkerAmbiguity, MotionFromEarlierFixesSettlesTheAmbiguousMarker) {
 TEST(SystemMarkerAmbiguity, WithoutEarlierFixesNothingIsUsed) {
   const AmbiguityRun run = RunClip(kSeveralMarkerFrames);
   EXPECT_GE(run.ambiguous_frames, 15);
-  EXPECT_EQ(run.stats.num_marker_disambiguations, 0);
+  EXPECT_EQ(run.stats.marker_fusion.num_disambiguations, 0);
   // Only the one-marker views that are not ambiguous give a fix and a pose.
   const int unambiguous = kNumFrames - kSeveralMarkerFrames - run.ambiguous_frames;
-  EXPECT_EQ(run.stats.num_marker_frames, unambiguous);
+  EXPECT_EQ(run.stats.marker_fusion.num_located_frames, unambiguous);
   EXPECT_EQ(static_cast<int>(run.trajectory.size()), unambiguous);
 }
 
@@ -151,9 +152,9 @@ TEST(SystemMarkerAmbiguity, PriorFarFromBothSolutionsSettlesNothing) {
   // prediction; once they are older than the prediction's reach there is no prior at all.
   const AmbiguityRun run = RunClip(0, Eigen::Vector3d(0.0, 0.0, -0.5));
   EXPECT_GE(run.ambiguous_frames, 15);
-  EXPECT_EQ(run.stats.num_marker_disambiguations, 0);
+  EXPECT_EQ(run.stats.marker_fusion.num_disambiguations, 0);
   const int unambiguous = kNumFrames - kSeveralMarkerFrames - run.ambiguous_frames;
-  EXPECT_EQ(run.stats.num_marker_frames, kSeveralMarkerFrames + unambiguous);
+  EXPECT_EQ(run.stats.marker_fusion.num_located_frames, kSeveralMarkerFrames + unambiguous);
 }
 
 }  // namespace

@@ -68,14 +68,14 @@ void System::FeedMarkerMapping(KeyframeId keyframe) {
 }
 
 void System::FeedMarkerView(const Frame& frame) {
-  if (!fix_ || marker_mapping_live_ || !options_.map_unknown_markers ||
+  const std::optional<MarkerFix>& fix = marker_fusion_.fix();
+  if (!fix || marker_mapping_live_ || !options_.map_unknown_markers ||
       !options_.marker_mapping.marker_views || frame.markers.empty()) {
     return;
   }
   std::vector<MarkerId> initialised;
-  const bool taken = EnsureMarkerMapper().AddMarkerView(fix_->world_from_cam.Inverse(),
-                                                        frame.camera, frame.markers,
-                                                        &initialised);
+  const bool taken = EnsureMarkerMapper().AddMarkerView(fix->world_from_cam.Inverse(), frame.camera,
+                                                        frame.markers, &initialised);
   if (!taken) return;
   for (const MarkerId& id : initialised) {
     ARUCOSLAM_LOG_DEBUG("frame at t {:.3f}: marker {} mapped from marker views",

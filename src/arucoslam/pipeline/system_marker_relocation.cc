@@ -10,31 +10,6 @@
 
 namespace arucoslam {
 
-std::optional<Rigid3> System::LocateInFinalMap(const std::vector<MarkerObservation>& markers,
-                                               const MarkerMap& final_map,
-                                               const std::optional<Rigid3>& previous) const {
-  std::vector<MarkerDetection> detections;
-  for (const MarkerObservation& observation : markers) {
-    detections.push_back(observation.AsDetection());
-  }
-  const CameraLocation location = LocateCamera(detections, final_map, camera_, options_.locator);
-  if (!location.found) return std::nullopt;
-  // An ambiguous location keeps the solution near the frame's earlier pose; without one it
-  // is not used.
-  AmbiguityChoice choice = AmbiguityChoice::kBest;
-  if (location.quality.ambiguous) {
-    choice = previous ? ResolveAmbiguity(location, previous->Inverse(), options_.ambiguity_gates)
-                      : AmbiguityChoice::kNone;
-  }
-  if (choice == AmbiguityChoice::kNone) return std::nullopt;
-  double nearest_sides = 0.0;
-  if (!UsableLocation(location, choice == AmbiguityChoice::kAlternative, final_map,
-                      &nearest_sides)) {
-    return std::nullopt;
-  }
-  return ChosenPose(location, choice)->Inverse();
-}
-
 void System::RelocateMarkerPoses() {
   if (!marker_mapper_ || !options_.relocate_marker_poses) return;
   const MarkerMap final_map = marker_mapper_->ToMarkerMap();
@@ -51,7 +26,8 @@ void System::RelocateMarkerPoses() {
     const bool fallback = !pose.in_world && pose.marker_cam_from_world;
     if (!fallback && pose.reference.IsValid()) continue;
     const Rigid3 current = fallback ? *pose.marker_cam_from_world : pose.cam_from_world;
-    const std::optional<Rigid3> located = LocateInFinalMap(pose.seen_markers, final_map, current);
+    const std::optional<Rigid3> located =
+        marker_fusion_.LocateInMap(pose.seen_markers, final_map, current);
     if (!located) continue;
     if (fallback) {
       pose.marker_cam_from_world = located;
@@ -63,7 +39,7 @@ void System::RelocateMarkerPoses() {
   }
   for (const UnposedMarkerFrame& frame : unposed_marker_frames_) {
     if (posed.count(frame.timestamp_s) != 0) continue;  // posed later (a backfill)
-    const std::optional<Rigid3> located = LocateInFinalMap(frame.markers, final_map, {});
+    const std::optional<Rigid3> located = marker_fusion_.LocateInMap(frame.markers, final_map, {});
     if (!located) continue;
     TrackedPose pose;
     pose.timestamp_s = frame.timestamp_s;

@@ -20,8 +20,8 @@ void System::RememberMarkerView(const FrameReport& report,
   std::optional<Rigid3> cam_from_world;  // in the marker world
   if (report.cam_from_world && (report.world_aligned || report.marker_pose)) {
     cam_from_world = *report.cam_from_world;
-  } else if (fix_) {
-    cam_from_world = fix_->world_from_cam.Inverse();
+  } else if (marker_fusion_.fix()) {
+    cam_from_world = marker_fusion_.fix()->world_from_cam.Inverse();
   }
   marker_search_->Remember(cam_from_world, detections);
 }

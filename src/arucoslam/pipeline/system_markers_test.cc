@@ -119,9 +119,9 @@ TEST(SystemMarkers, OptionsCheck) {
   options.min_alignment_anchors = 1;
   EXPECT_FALSE(options.Check());
   for (const auto& breaks : std::vector<std::function<void(SystemOptions*)>>{
-           [](SystemOptions* o) { o->min_drift_interval_s = -1.0; },
-           [](SystemOptions* o) { o->max_drift_step_m = -0.1; },
-           [](SystemOptions* o) { o->max_drift_correction_frames = 0; }}) {
+           [](SystemOptions* o) { o->marker_fusion.min_drift_interval_s = -1.0; },
+           [](SystemOptions* o) { o->marker_fusion.max_drift_step_m = -0.1; },
+           [](SystemOptions* o) { o->marker_fusion.max_drift_correction_frames = 0; }}) {
     SystemOptions drift;
     drift.marker_map = SceneMarkers();
     breaks(&drift);
@@ -313,7 +313,7 @@ TEST(SystemMarkers, KeypointPoseThatTheMarkersContradictIsRejected) {
   }
   system.Finish();
   ASSERT_TRUE(system.world_aligned());
-  EXPECT_GE(system.Stats().num_marker_disagreements, 1);
+  EXPECT_GE(system.Stats().marker_fusion.num_rejected_poses, 1);
   for (int t = 70; t < 80; ++t) {
     if (!reports[t].cam_from_world) continue;
     const Eigen::Vector3d centre = reports[t].cam_from_world->Inverse().translation;
@@ -385,8 +385,8 @@ TEST(SystemMarkers, DriftThatTheMarkersRevealAfterAGapIsCorrectedNotRejected) {
   // keypoint pose, becomes a keyframe, and the pose-graph correction moves the map towards
   // the markers: from then on every frame is tracked within the 0.5 m gate of them.
   const DriftRun run = RunWithShiftedMarkers(ShiftAfterGap);
-  EXPECT_EQ(run.stats.num_drift_disagreements, 1);
-  EXPECT_EQ(run.stats.num_marker_disagreements, 0);
+  EXPECT_EQ(run.stats.marker_fusion.num_drift_disagreements, 1);
+  EXPECT_EQ(run.stats.marker_fusion.num_rejected_poses, 0);
   EXPECT_GE(run.stats.num_marker_corrections, 1);
   EXPECT_EQ(run.stats.num_resets, 0);
   ASSERT_TRUE(run.reports[100].cam_from_world);
@@ -405,8 +405,8 @@ TEST(SystemMarkers, ThreadedDriftCorrectionSeesTheKeyframesMarkers) {
     options->blocking = false;
     options->synchronous_young_map_keyframes = 1000;
   });
-  EXPECT_EQ(run.stats.num_drift_disagreements, 1);
-  EXPECT_EQ(run.stats.num_marker_disagreements, 0);
+  EXPECT_EQ(run.stats.marker_fusion.num_drift_disagreements, 1);
+  EXPECT_EQ(run.stats.marker_fusion.num_rejected_poses, 0);
   EXPECT_GE(run.stats.num_marker_corrections, 1);
   for (int t = 101; t < 140; ++t) {
     ASSERT_TRUE(run.reports[t].cam_from_world) << t;
@@ -415,10 +415,11 @@ TEST(SystemMarkers, ThreadedDriftCorrectionSeesTheKeyframesMarkers) {
 }
 
 TEST(SystemMarkers, DriftCorrectionOffRejectsTheSameDisagreement) {
-  const DriftRun run = RunWithShiftedMarkers(
-      ShiftAfterGap, [](SystemOptions* options) { options->correct_drift_beyond_gate = false; });
-  EXPECT_EQ(run.stats.num_drift_disagreements, 0);
-  EXPECT_GE(run.stats.num_marker_disagreements, 1);
+  const DriftRun run = RunWithShiftedMarkers(ShiftAfterGap, [](SystemOptions* options) {
+    options->marker_fusion.correct_drift_beyond_gate = false;
+  });
+  EXPECT_EQ(run.stats.marker_fusion.num_drift_disagreements, 0);
+  EXPECT_GE(run.stats.marker_fusion.num_rejected_poses, 1);
 }
 
 // Markers in view all along, seen 5 cm further off each frame from frame 60 (1.5 m by 90):
@@ -430,8 +431,8 @@ TEST(SystemMarkers, DisagreementGrowingFrameByFrameIsDrift) {
   // previous frame: drift. The map follows the markers instead of being rejected; by frame
   // 120 it is back within the gate of them, more than 1 m from where the keypoints put it.
   const DriftRun run = RunWithShiftedMarkers(GrowingShift);
-  EXPECT_GE(run.stats.num_drift_disagreements, 1);
-  EXPECT_EQ(run.stats.num_marker_disagreements, 0);
+  EXPECT_GE(run.stats.marker_fusion.num_drift_disagreements, 1);
+  EXPECT_EQ(run.stats.marker_fusion.num_rejected_poses, 0);
   EXPECT_EQ(run.stats.num_resets, 0);
   for (int t = 60; t < 140; ++t) {
     ASSERT_TRUE(run.reports[t].cam_from_world) << t;
@@ -445,9 +446,9 @@ TEST(SystemMarkers, DisagreementGrowingFrameByFrameIsDrift) {
 
 TEST(SystemMarkers, DisagreementGrowingFrameByFrameIsRejectedWithoutTheStepRule) {
   const DriftRun run = RunWithShiftedMarkers(
-      GrowingShift, [](SystemOptions* options) { options->max_drift_step_m = 0.0; });
-  EXPECT_EQ(run.stats.num_drift_disagreements, 0);
-  EXPECT_GE(run.stats.num_marker_disagreements, 1);
+      GrowingShift, [](SystemOptions* options) { options->marker_fusion.max_drift_step_m = 0.0; });
+  EXPECT_EQ(run.stats.marker_fusion.num_drift_disagreements, 0);
+  EXPECT_GE(run.stats.marker_fusion.num_rejected_poses, 1);
 }
 
 }  // namespace

@@ -104,20 +104,21 @@ bool System::CloseMap() {
 }
 
 bool System::InitializeFromMarkers(Frame& frame, FrameReport& report) {
-  if (!fix_) return false;
+  const std::optional<MarkerFix>& fix = marker_fusion_.fix();
+  if (!fix) return false;
   if (!init_reference_fix_) {
     // A reference with a marker location allows the metric initialisation below.
     if (report.num_features >= options_.initializer.min_matches) {
       KeepForBackfill();
       init_reference_ = frame;
-      init_reference_fix_ = fix_;
+      init_reference_fix_ = fix;
       report.message = "initialisation reference (markers)";
       return true;
     }
     return false;
   }
   const Rigid3& world_from_cam1 = init_reference_fix_->world_from_cam;
-  const Rigid3& world_from_cam2 = fix_->world_from_cam;
+  const Rigid3& world_from_cam2 = fix->world_from_cam;
   const double baseline = (world_from_cam1.translation - world_from_cam2.translation).norm();
   if (baseline < options_.min_marker_init_baseline_m) {
     report.message = "waiting for a marker baseline";  // marker poses are output meanwhile
@@ -160,8 +161,7 @@ bool System::InitializeFromMarkers(Frame& frame, FrameReport& report) {
   first.cam_from_world = to_world(*first.cam_from_world);
   frame.cam_from_world = to_world(*frame.cam_from_world);
   world_aligned_ = true;
-  markers_agreed_s_ = frame.timestamp_s;
-  rotation_vote_.Clear();
+  marker_fusion_.MapEnteredWorld(frame.timestamp_s);
   keep_marker_keyframes_ = false;
   RefreshKeyframePoseCache();
   next_alignment_anchors_ = options_.min_alignment_anchors;  // re-aligned as anchors come

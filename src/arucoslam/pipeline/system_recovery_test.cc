@@ -306,11 +306,11 @@ TEST(SystemRecovery, FarMarkersGiveNoLocation) {
   scenario.markers = true;
   scenario.marker_size = 0.1;  // 3 m away: 30 sides, beyond max_marker_distance_sides (25)
   const ScenarioRun far = RunScenario(scenario);
-  EXPECT_EQ(far.stats.num_marker_frames, 0);
+  EXPECT_EQ(far.stats.marker_fusion.num_located_frames, 0);
   EXPECT_TRUE(far.trajectory.empty());  // the keypoint map is never put in the world
   scenario.marker_size = 0.2;  // 15 sides
   const ScenarioRun near = RunScenario(scenario);
-  EXPECT_GT(near.stats.num_marker_frames, 20);
+  EXPECT_GT(near.stats.marker_fusion.num_located_frames, 20);
 }
 
 }  // namespace

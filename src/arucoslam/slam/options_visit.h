@@ -13,6 +13,7 @@
 #include "arucoslam/slam/loop_closer.h"
 #include "arucoslam/slam/loop_detector.h"
 #include "arucoslam/slam/map_initialization.h"
+#include "arucoslam/slam/marker_fusion.h"
 #include "arucoslam/slam/marker_mapper.h"
 #include "arucoslam/slam/relocalizer.h"
 #include "arucoslam/slam/tracker.h"
@@ -275,6 +276,36 @@ void VisitOptions(CovisibleMarkerVoteOptions& o, Visitor& visit) {
   visit("min_agreement_margin", o.min_agreement_margin,
         "a frame pair votes when one solution puts this many more markers in agreement");
   visit("min_votes", o.min_votes, "votes for one solution (none for the other) that settle it");
+}
+
+template <class Visitor>
+void VisitOptions(MarkerFusionOptions& o, Visitor& visit) {
+  visit("locator", o.locator, "camera pose from the markers (LocateCamera)");
+  visit("max_marker_rms_px", o.max_marker_rms_px,
+        "a marker location is used with a corner RMS at most this, pixels");
+  visit("max_marker_distance_sides", o.max_marker_distance_sides,
+        "... and its nearest marker at most this many marker sides away");
+  visit("resolve_ambiguity_by_motion", o.resolve_ambiguity_by_motion,
+        "an ambiguous one-marker location settled by a motion prediction");
+  visit("ambiguity_gates", o.ambiguity_gates, "gates of that prediction");
+  visit("fix_motion", o.fix_motion, "constant-velocity prediction from recent marker fixes");
+  visit("resolve_ambiguity_by_map_rotation", o.resolve_ambiguity_by_map_rotation,
+        "unaligned map: ambiguous markers settled by the map's voted world orientation");
+  visit("rotation_vote", o.rotation_vote, "that vote");
+  visit("map_rotation_gates", o.map_rotation_gates, "gates of the voted orientation");
+  visit("resolve_ambiguity_by_covisible_markers", o.resolve_ambiguity_by_covisible_markers,
+        "else: ambiguous markers settled by the unknown markers seen with them");
+  visit("covisible_vote", o.covisible_vote, "that vote");
+  visit("max_marker_disagreement_m", o.max_marker_disagreement_m,
+        "a keypoint pose farther than this from the frame's marker location is wrong, metres");
+  visit("correct_drift_beyond_gate", o.correct_drift_beyond_gate,
+        "such a disagreement after steady tracking is drift, corrected with the markers");
+  visit("min_drift_interval_s", o.min_drift_interval_s,
+        "drift when tracked without a break this long since the markers agreed, seconds");
+  visit("max_drift_step_m", o.max_drift_step_m,
+        "sooner: drift only when the disagreement grew at most this since the last, metres");
+  visit("max_drift_correction_frames", o.max_drift_correction_frames,
+        "frames that wait for a drift correction");
 }
 
 }  // namespace arucoslam
