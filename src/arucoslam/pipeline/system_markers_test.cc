@@ -179,6 +179,7 @@ TEST(SystemMarkers, ThreadedRunMapsEachKeyframeBeforeTheNextFrameUntilAligned) {
   SystemOptions options;
   options.blocking = false;
   options.synchronous_young_map_keyframes = 0;
+  options.synchronous_until_aligned = true;  // off by default
   options.marker_map = SceneMarkers();
   System system(camera, options);
   std::mt19937 rng(7);
