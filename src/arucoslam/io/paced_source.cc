@@ -22,7 +22,6 @@ PacedSource::PacedSource(std::unique_ptr<FrameSource> recorded, const PacedSourc
   std::string why;
   if (!options.Check(&why)) throw std::invalid_argument("PacedSourceOptions: " + why);
   queue_ = std::make_unique<Queue>(options.queue_capacity);
-  thread_ = std::thread([this] { Replay(); });
 }
 
 PacedSource::~PacedSource() {
@@ -67,6 +66,7 @@ void PacedSource::Replay() {
 }
 
 std::optional<SourceFrame> PacedSource::Next() {
+  if (!thread_.joinable()) thread_ = std::thread([this] { Replay(); });
   std::optional<SourceFrame> frame = queue_->frames.Pop();
   if (frame) {
     frame->index = next_index_++;

@@ -35,16 +35,16 @@ struct PacedSourceOptions {
 
 class PacedSource : public FrameSource {
  public:
-  // Starts the replay at once: the first frame is due now, each next one when its timestamp's
-  // offset from the first has elapsed (over `speed`). Throws std::invalid_argument on options
-  // that fail Check().
+  // The replay starts with the first Next(): the first frame is due then, each next one when
+  // its timestamp's offset from the first has elapsed (over `speed`). Throws
+  // std::invalid_argument on options that fail Check().
   explicit PacedSource(std::unique_ptr<FrameSource> recorded, const PacedSourceOptions& options = {});
   // Stops and joins the replay thread.
   ~PacedSource() override;
   PacedSource(const PacedSource&) = delete;
   PacedSource& operator=(const PacedSource&) = delete;
 
-  // Waits for the next frame handed over; nullopt at the end of the recording (or on a stop
+  // Waits for the next frame handed over (the first call starts the replay); nullopt at the end of the recording (or on a stop
   // request) once the held frames are out. Rethrows what reading the recording threw.
   std::optional<SourceFrame> Next() override;
   const CameraModel& camera() const override { return recorded_->camera(); }

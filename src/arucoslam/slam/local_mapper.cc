@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "arucoslam/util/logging.h"
 #include "arucoslam/util/option_check.h"
 #include "arucoslam/util/timing.h"
 
@@ -27,6 +28,7 @@ bool LocalMapperOptions::Check(std::string* why) const {
   check.InRange("redundant_fraction", redundant_fraction, 0.0, 1.0, Interval::kOpenClosed);
   check.AtLeast("redundant_observers", redundant_observers, 1);
   check.AtLeast("min_marker_keyframes", min_marker_keyframes, 0);
+  check.AtLeast("min_keyframe_points", min_keyframe_points, 0);
   return check.ok();
 }
 
@@ -118,6 +120,12 @@ bool IsRedundant(const MapData& data, const Keyframe& candidate, double fraction
   return num_points > 0 && num_redundant > fraction * num_points;
 }
 
+int NumMapPoints(const Keyframe& keyframe) {
+  return static_cast<int>(std::count_if(keyframe.map_point_ids.begin(),
+                                        keyframe.map_point_ids.end(),
+                                        [](const MapPointId& id) { return id.IsValid(); }));
+}
+
 // Whether `candidate` saw a marker of `markers` that fewer than `min_others` other
 // keyframes saw.
 bool HoldsRareMarkerView(const Keyframe& candidate, const MarkerLandmarks* markers,
@@ -137,11 +145,17 @@ int LocalMapper::CullRedundantKeyframes(KeyframeId keyframe) {
   // One keyframe at a time: each erasure changes what the next candidates share.
   return map_.Write([&](MapData& data) {
     if (data.FindKeyframe(keyframe) == nullptr) return 0;
+    // Only older keyframes: newer ones may still wait in the mapper's queue.
+    const auto older = [&](KeyframeId id) { return id != data.FirstKeyframe() && id < keyframe; };
     std::vector<KeyframeId> candidates;
     for (const auto& [candidate, weight] : data.covisibility().Neighbours(keyframe)) {
-      // Only older keyframes: newer ones may still wait in the mapper's queue.
-      if (candidate != data.FirstKeyframe() && candidate < keyframe) {
-        candidates.push_back(candidate);
+      if (older(candidate)) candidates.push_back(candidate);
+    }
+    // Keyframes that lost their points need not be covisible with anything any more.
+    for (const auto& [id, candidate] : data.keyframes()) {
+      if (older(id) && NumMapPoints(candidate) < options_.min_keyframe_points &&
+          std::find(candidates.begin(), candidates.end(), id) == candidates.end()) {
+        candidates.push_back(id);
       }
     }
     int erased = 0;
@@ -150,9 +164,20 @@ int LocalMapper::CullRedundantKeyframes(KeyframeId keyframe) {
       if (candidate == nullptr ||
           (keep_ && keep_(*candidate)) ||
           HoldsRareMarkerView(*candidate, markers_, options_.min_marker_keyframes) ||
-          !IsRedundant(data, *candidate, options_.redundant_fraction,
-                       options_.redundant_observers)) {
+          (NumMapPoints(*candidate) >= options_.min_keyframe_points &&
+           !IsRedundant(data, *candidate, options_.redundant_fraction,
+                        options_.redundant_observers))) {
         continue;
+      }
+      const int num_points = NumMapPoints(*candidate);
+      if (num_points < options_.min_keyframe_points) {
+        int num_seen_thrice = 0;
+        for (const MapPointId& point_id : candidate->map_point_ids) {
+          const MapPoint* point = point_id.IsValid() ? data.FindMapPoint(point_id) : nullptr;
+          if (point != nullptr && point->NumObservations() >= 3) ++num_seen_thrice;
+        }
+        ARUCOSLAM_LOG_DEBUG("keyframe {} erased: {} map points left, {} seen by 3 keyframes or more",
+                            id.value, num_points, num_seen_thrice);
       }
       if (!data.EraseKeyframe(id)) continue;
       ++erased;

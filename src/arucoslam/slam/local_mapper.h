@@ -60,6 +60,9 @@ struct LocalMapperOptions {
   // other keyframes.
   double redundant_fraction = 0.9;
   int redundant_observers = 3;
+  // An older keyframe (not the first) left with fewer map points than this is erased too:
+  // nothing can be tracked from it, and bundle adjustment cannot hold its pose.
+  int min_keyframe_points = 15;
   bool cull_keyframes = true;
   // With marker landmarks set: a keyframe is kept while one of the markers it saw is seen
   // by fewer than this many other keyframes (a marker's views hold its pose and the scale).

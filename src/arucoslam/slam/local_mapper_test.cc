@@ -264,6 +264,49 @@ TEST(LocalMapper, CullsRedundantKeyframesOneAtATime) {
   });
 }
 
+// Keyframe 1 of five keeps 10 points, seen by keyframe 0 alone besides it: not covisible with
+// keyframe 4, none of its points redundant. Under min_keyframe_points it is erased all the
+// same, unless guarded; with 10 points or more it stays.
+TEST(LocalMapper, ErasesAnOlderKeyframeThatLostItsPoints) {
+  for (const int min_points : {15, 10}) {
+    for (const bool guarded : {false, true}) {
+      Scene scene(3);
+      Map map;
+      const auto keyframes = BuildMap(scene, map, {0, 1, 2, 3, 4}, [](int) { return true; });
+      map.Write([&](MapData& data) {
+        const std::vector<MapPointId> points = data.MapPointsOf(keyframes[1].id);
+        EXPECT_GT(points.size(), 30u);
+        for (std::size_t i = 0; i < points.size(); ++i) {
+          if (i >= 10) {
+            data.EraseObservation(keyframes[1].id, points[i]);
+            continue;
+          }
+          for (int k = 2; k < 5; ++k) data.EraseObservation(keyframes[k].id, points[i]);
+        }
+        return 0;
+      });
+      LocalMapperOptions options;
+      options.redundant_observers = 10;  // no keyframe is redundant by its points
+      options.min_keyframe_points = min_points;
+      LocalMapper mapper(map, options);
+      if (guarded) {
+        const KeyframeId kept = keyframes[1].id;
+        mapper.SetKeyframeGuard([kept](const Keyframe& keyframe) { return keyframe.id == kept; });
+      }
+      const bool erased = min_points > 10 && !guarded;
+      EXPECT_EQ(mapper.CullRedundantKeyframes(keyframes[4].id), erased ? 1 : 0)
+          << min_points << " " << guarded;
+      map.Read([&](const MapData& data) {
+        EXPECT_EQ(data.FindKeyframe(keyframes[1].id) == nullptr, erased);
+        EXPECT_EQ(data.covisibility().Weight(keyframes[1].id, keyframes[4].id), 0);
+        for (int k : {0, 2, 3, 4}) EXPECT_NE(data.FindKeyframe(keyframes[k].id), nullptr);
+        EXPECT_EQ(data.CheckInvariants(), "");
+        return 0;
+      });
+    }
+  }
+}
+
 // Local BA of keyframe 12 in a map of four keyframes whose points were moved off their
 // true positions, with `yield` as the mapper's yield request, heeded from the first iteration.
 LocalMappingResult MapPerturbedKeyframe(std::function<bool()> yield) {

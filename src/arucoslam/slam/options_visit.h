@@ -140,6 +140,8 @@ void VisitOptions(LocalMapperOptions& o, Visitor& visit) {
   visit("redundant_fraction", o.redundant_fraction,
         "keyframe culling: this fraction of its points seen by redundant_observers others");
   visit("redundant_observers", o.redundant_observers, "... at the same or a finer scale");
+  visit("min_keyframe_points", o.min_keyframe_points,
+        "an older keyframe with fewer map points than this is erased too");
   visit("cull_keyframes", o.cull_keyframes, "erase redundant keyframes");
   visit("min_marker_keyframes", o.min_marker_keyframes,
         "a keyframe stays while one of its markers is seen by fewer other keyframes");
