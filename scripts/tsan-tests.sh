@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # ThreadSanitizer build of the threaded tests (the System in threaded mode, local mapping and
-# loop closing on their threads, the marker detector and ORB thread pools) run clean, or fail.
+# loop closing on their threads, the marker detector and ORB thread pools, the real-time replay)
+# run clean, or fail.
 # Usage: scripts/tsan-tests.sh [BUILD_DIR]   (default build-tsan; `make tsan` calls it)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -16,6 +17,7 @@ tests=(
   "src/arucoslam/util/test_util_thread_pool_test|*"
   "src/arucoslam/feature/test_feature_orb_extractor_test|*ThreadCount*"
   "src/arucoslam/map/test_map_map_test|*Concurrent*"
+  "src/arucoslam/io/test_io_paced_source_test|*"
 )
 
 # -O1 keeps the instrumented tests fast enough; no ROS, no benchmarks: only what they link.
