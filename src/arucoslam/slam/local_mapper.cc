@@ -161,23 +161,18 @@ int LocalMapper::CullRedundantKeyframes(KeyframeId keyframe) {
     int erased = 0;
     for (const KeyframeId& id : candidates) {
       const Keyframe* candidate = data.FindKeyframe(id);
-      if (candidate == nullptr ||
-          (keep_ && keep_(*candidate)) ||
-          HoldsRareMarkerView(*candidate, markers_, options_.min_marker_keyframes) ||
-          (NumMapPoints(*candidate) >= options_.min_keyframe_points &&
-           !IsRedundant(data, *candidate, options_.redundant_fraction,
-                        options_.redundant_observers))) {
+      if (candidate == nullptr || (keep_ && keep_(*candidate)) ||
+          HoldsRareMarkerView(*candidate, markers_, options_.min_marker_keyframes)) {
         continue;
       }
       const int num_points = NumMapPoints(*candidate);
-      if (num_points < options_.min_keyframe_points) {
-        int num_seen_thrice = 0;
-        for (const MapPointId& point_id : candidate->map_point_ids) {
-          const MapPoint* point = point_id.IsValid() ? data.FindMapPoint(point_id) : nullptr;
-          if (point != nullptr && point->NumObservations() >= 3) ++num_seen_thrice;
-        }
-        ARUCOSLAM_LOG_DEBUG("keyframe {} erased: {} map points left, {} seen by 3 keyframes or more",
-                            id.value, num_points, num_seen_thrice);
+      const bool lost_its_points = num_points < options_.min_keyframe_points;
+      if (!lost_its_points && !IsRedundant(data, *candidate, options_.redundant_fraction,
+                                           options_.redundant_observers)) {
+        continue;
+      }
+      if (lost_its_points) {
+        ARUCOSLAM_LOG_DEBUG("keyframe {} erased: {} map points left", id.value, num_points);
       }
       if (!data.EraseKeyframe(id)) continue;
       ++erased;

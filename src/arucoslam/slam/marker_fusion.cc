@@ -6,16 +6,12 @@
 #include <cmath>
 #include <limits>
 
+#include "arucoslam/optim/marker_corner_error.h"
 #include "arucoslam/util/logging.h"
 #include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 namespace {
-
-Eigen::Vector2d UndistortedPixel(const CameraModel& camera, const Eigen::Vector2d& pixel) {
-  const Eigen::Vector2d normalised = camera.Unproject(pixel);
-  return {camera.fx * normalised.x() + camera.cx, camera.fy * normalised.y() + camera.cy};
-}
 
 // Distance from the camera at `world_from_cam` to its nearest located marker, in that
 // marker's sides.
@@ -161,9 +157,7 @@ MarkerFix MarkerFusion::MakeFix(const CameraLocation& location, const Rigid3& wo
     MarkerPoseObservation observation;
     observation.world_from_marker = info->world_from_marker;
     observation.size = info->size;
-    for (int c = 0; c < 4; ++c) {
-      observation.corners_px[c] = UndistortedPixel(camera_, detection.corners[c]);
-    }
+    observation.corners_px = UndistortedCorners(camera_, detection.corners);
     fix.markers.push_back(observation);
   }
   return fix;
