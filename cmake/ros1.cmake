@@ -38,6 +38,7 @@ if(ARUCOSLAM_ROS)
     endif()
   endforeach()
   find_program(ROS1_MASTER_PROGRAM rosmaster)
+  find_program(ROS1_LAUNCH_PROGRAM roslaunch)
   if(_ros_missing)
     list(JOIN _ros_missing ", " _ros_missing_text)
     message(STATUS "ROS 1 not found (missing ${_ros_missing_text}): skipping io/rosbag/, "

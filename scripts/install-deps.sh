@@ -11,11 +11,11 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libsdformat-dev
   libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri
-  # ROS 1 (Debian's Noetic-era packages): bag input, the arucoslam_ros node and its test's
-  # rosmaster. No desktop meta-packages.
+  # ROS 1 (Debian's Noetic-era packages): bag input, the arucoslam_ros node, its test's
+  # rosmaster and roslaunch. No desktop meta-packages.
   libroscpp-dev librosbag-storage-dev libtf2-ros-dev libimage-transport-dev
   libsensor-msgs-dev libgeometry-msgs-dev libnav-msgs-dev libvisualization-msgs-dev
-  libdiagnostic-msgs-dev libtf2-msgs-dev python3-rosmaster
+  libdiagnostic-msgs-dev libtf2-msgs-dev python3-rosmaster python3-roslaunch
 )
 
 missing=()
