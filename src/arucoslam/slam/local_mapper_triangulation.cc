@@ -3,6 +3,7 @@
 // passes the parallax, depth, reprojection and scale-consistency checks.
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <optional>
 
@@ -31,9 +32,23 @@ std::vector<FeatureMatch> MatchAlongEpipolarLines(const Keyframe& kf1, const Key
   const bool has_epipole = t.z() > 1e-9;
   const Eigen::Vector2d epipole = has_epipole ? Eigen::Vector2d(t.x() / t.z(), t.y() / t.z())
                                               : Eigen::Vector2d::Zero();
-  std::vector<int> free2;
+  // The unmatched keypoints of kf2 away from the epipole, with their epipolar band: what
+  // the inner loop needs, packed, in kf2's keypoint order.
+  struct Candidate {
+    Eigen::Vector3d x2;            // undistorted, homogeneous
+    double max_distance2_px = 0.0; // epipolar_chi2 x sigma^2
+    int index = 0;
+  };
+  std::vector<Candidate> candidates;
   for (std::size_t j = 0; j < kf2.map_point_ids.size(); ++j) {
-    if (!kf2.map_point_ids[j].IsValid()) free2.push_back(static_cast<int>(j));
+    if (kf2.map_point_ids[j].IsValid()) continue;
+    const int index = static_cast<int>(j);
+    const Eigen::Vector2d& x2 = kf2.features.undistorted[j];
+    if (has_epipole && (x2 - epipole).norm() * focal2 <
+                           options.min_epipole_distance_px * kf2.SigmaPx(index)) {
+      continue;
+    }
+    candidates.push_back({x2.homogeneous(), options.epipolar_chi2 * Sigma2(kf2, index), index});
   }
   std::vector<int> best_for_2(kf2.features.size(), -1);
   std::vector<int> best_distance_2(kf2.features.size(), std::numeric_limits<int>::max());
@@ -42,22 +57,16 @@ std::vector<FeatureMatch> MatchAlongEpipolarLines(const Keyframe& kf1, const Key
     const Eigen::Vector3d line = essential * kf1.features.undistorted[i].homogeneous();
     const double norm2 = line.head<2>().squaredNorm();
     if (norm2 <= 0.0) continue;
+    const std::uint8_t* descriptor1 = kf1.features.Descriptor(static_cast<int>(i));
     int best = -1, best_distance = options.max_match_distance + 1, second = 256;
-    for (int j : free2) {
-      const Eigen::Vector2d& x2 = kf2.features.undistorted[j];
-      const double along = line.dot(x2.homogeneous());
-      const double distance2_px = along * along / norm2 * focal2 * focal2;
-      if (distance2_px > options.epipolar_chi2 * Sigma2(kf2, j)) continue;
-      if (has_epipole && (x2 - epipole).norm() * focal2 <
-                             options.min_epipole_distance_px * kf2.SigmaPx(j)) {
-        continue;
-      }
-      const int distance = HammingDistance(kf1.features.Descriptor(static_cast<int>(i)),
-                                           kf2.features.Descriptor(j));
+    for (const Candidate& candidate : candidates) {
+      const double along = line.dot(candidate.x2);
+      if (along * along / norm2 * focal2 * focal2 > candidate.max_distance2_px) continue;
+      const int distance = HammingDistance(descriptor1, kf2.features.Descriptor(candidate.index));
       if (distance < best_distance) {
         second = best_distance;
         best_distance = distance;
-        best = j;
+        best = candidate.index;
       } else if (distance < second) {
         second = distance;
       }
