@@ -58,9 +58,10 @@ std::vector<float> Angles(const OrbFeatures& features) {
 }  // namespace
 
 // Two builds of the count, chosen when the program loads: the popcnt instruction where the
-// CPU has one, else a bit-parallel count (the portable build has no popcnt, and
-// std::popcount there is a library call per word).
-#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
+// CPU has one, else the compiler's portable count. Not in sanitizer builds: the loader picks
+// the build before the sanitizer's runtime is up, and ThreadSanitizer crashes there.
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__) && \
+    !defined(__SANITIZE_THREAD__) && !defined(__SANITIZE_ADDRESS__)
 __attribute__((target_clones("popcnt", "default")))
 #endif
 int HammingDistance(const std::uint8_t* a, const std::uint8_t* b) {
