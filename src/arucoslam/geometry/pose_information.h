@@ -1,5 +1,5 @@
-// Information matrices of pose priors from standard deviations: what a prior on a camera pose
-// weighs in a pose graph or an adjustment, ordered [centre (3); rotation (3)] like KeyframePosePrior.
+// Information matrices of camera pose priors from standard deviations: what a prior weighs in a
+// pose graph or an adjustment, ordered [centre (3); rotation (3)] as KeyframePosePrior's.
 #pragma once
 
 #include <Eigen/Core>

@@ -7,8 +7,8 @@ namespace {
 
 TEST(IsotropicPoseInformation, InverseVariancesOnTheDiagonal) {
   const Matrix6d information = IsotropicPoseInformation(0.5, 0.1);
-  for (int i = 0; i < 3; ++i) EXPECT_DOUBLE_EQ(information(i, i), 4.0);         // 1 / 0.5^2
-  for (int i = 3; i < 6; ++i) EXPECT_NEAR(information(i, i), 100.0, 1e-9);      // 1 / 0.1^2
+  for (int i = 0; i < 3; ++i) EXPECT_DOUBLE_EQ(information(i, i), 4.0);     // 1 / 0.5^2
+  for (int i = 3; i < 6; ++i) EXPECT_NEAR(information(i, i), 100.0, 1e-9);  // 1 / 0.1^2
   Matrix6d off_diagonal = information;
   off_diagonal.diagonal().setZero();
   EXPECT_EQ(off_diagonal.cwiseAbs().maxCoeff(), 0.0);

@@ -62,8 +62,7 @@ void System::ResetMap() {
   MakeLocalMapper();
   MakePlaceRecognition();
   const int marker_generation = ResetMarkerMapping();
-  map_session_.StartNewMap(kept_for_merge ? std::optional<int>(marker_generation)
-                                          : std::nullopt);
+  map_session_.StartNewMap(kept_for_merge ? std::optional<int>(marker_generation) : std::nullopt);
   HandOutBridgePriors();  // none: the new places hold none yet, the marker mapper drops them
   poses_ = std::move(kept);
   init_reference_.reset();
@@ -97,8 +96,8 @@ bool System::CloseMap() {
   AdjustWholeMapWithMarkers("map closed");
   ClosingWorldMap closing;
   // Frames off their keyframes (a plain wall before the loss) would bend the bridge's velocity.
-  closing.motion_poses = DropPosesOffTheirKeyframes(
-      CurrentMapPoses(/*world_only=*/true), KeyframePoses(), options_.pose_consistency);
+  closing.motion_poses = DropPosesOffTheirKeyframes(CurrentMapPoses(/*world_only=*/true),
+                                                    KeyframePoses(), options_.pose_consistency);
   closing.keyframes = KeyframePoses();
   closing.points = MapPoints();
   {
@@ -148,10 +147,10 @@ bool System::MergeClosedMap() {
     for (const auto& [old_id, id] : ids.keyframes) absorbed.push_back(id);
     places_->IndexKeyframes(absorbed);
   }
-  ARUCOSLAM_LOG_DEBUG("closed map merged into the current one: {} keyframes, {} points, {} "
-                      "poses follow them, {} with marker views; attached to keyframe {}",
-                      ids.keyframes.size(), ids.points.size(), followed, revived,
-                      merged->attached_to.value);
+  ARUCOSLAM_LOG_DEBUG(
+      "closed map merged into the current one: {} keyframes, {} points, {} "
+      "poses follow them, {} with marker views; attached to keyframe {}",
+      ids.keyframes.size(), ids.points.size(), followed, revived, merged->attached_to.value);
   return true;
 }
 

@@ -65,8 +65,7 @@ MapClosing MapSession::Closing(std::size_t num_keyframes, bool world_aligned) {
   return MapClosing::kInWorld;
 }
 
-void MapSession::KeepBiggestKeypointMap(std::vector<StampedPose> poses,
-                                        std::size_t num_keyframes) {
+void MapSession::KeepBiggestKeypointMap(std::vector<StampedPose> poses, std::size_t num_keyframes) {
   biggest_closed_poses_ = std::move(poses);
   biggest_closed_keyframes_ = num_keyframes;
 }

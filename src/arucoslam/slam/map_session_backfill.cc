@@ -35,9 +35,8 @@ std::vector<Frame> MapSession::TrackBackfill(Map& map, const TrackerOptions& tra
   std::vector<Frame> tracked;
   if (frames.empty()) return tracked;
   // A replaced reference is kept when it is replaced, after the frames that followed it.
-  std::stable_sort(frames.begin(), frames.end(), [](const Frame& a, const Frame& b) {
-    return a.timestamp_s < b.timestamp_s;
-  });
+  std::stable_sort(frames.begin(), frames.end(),
+                   [](const Frame& a, const Frame& b) { return a.timestamp_s < b.timestamp_s; });
   TrackerOptions backwards_options = tracking;
   backwards_options.update_point_statistics = false;  // the map stays exactly as it is
   Tracker backwards(map, backwards_options);

@@ -1,7 +1,5 @@
 // MapSession's backfill on a synthetic point cloud: a camera moving sideways 5 cm per frame, a
 // map initialised from frames 0 and 10, and the frames kept before it tracked backwards.
-#include "arucoslam/slam/map_session.h"
-
 #include <gtest/gtest.h>
 
 #include <vector>
@@ -9,6 +7,7 @@
 #include "arucoslam/geometry/camera.h"
 #include "arucoslam/slam/initializer.h"
 #include "arucoslam/slam/map_initialization.h"
+#include "arucoslam/slam/map_session.h"
 #include "arucoslam/slam/synthetic_features.h"
 
 namespace arucoslam {
@@ -83,7 +82,7 @@ TEST(MapSessionBackfill, KeptFramesAreTrackedBackwardsNewestFirst) {
     ASSERT_TRUE(tracked[i].cam_from_world.has_value());
     EXPECT_LT(scene.OffPath(tracked[i], t), 0.05) << "frame " << t;
   }
-  EXPECT_EQ(map.NumMapPoints(), points);                  // the map is left as it was
+  EXPECT_EQ(map.NumMapPoints(), points);              // the map is left as it was
   EXPECT_TRUE(scene.Backfill(session, map).empty());  // the kept frames are used up
 }
 

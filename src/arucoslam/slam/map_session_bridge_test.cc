@@ -1,12 +1,11 @@
 // MapSession's bridge over a tracking gap: the closed map's last second of motion predicts the
 // next map's first keyframe, with sigmas growing with the gap, and the merged map is corrected
 // towards that prediction by the pose graph.
-#include "arucoslam/slam/map_session.h"
-
 #include <gtest/gtest.h>
 
 #include <vector>
 
+#include "arucoslam/slam/map_session.h"
 #include "arucoslam/slam/synthetic_route_map.h"
 
 namespace arucoslam {
@@ -51,10 +50,8 @@ TEST(MapSessionBridge, PriorSigmasGrowWithTheGap) {
   EXPECT_NEAR(far.information(5, 5), InverseSquare(1.05), 1e-9);
   // In the bundle adjustments: 0.025 m + 0.3 m/s^2 x gap^2 / 2, the rotation as above.
   ASSERT_EQ(session.bridge_adjustment_priors().size(), 2u);
-  EXPECT_NEAR(session.bridge_adjustment_priors()[0].information(0, 0), InverseSquare(0.0625),
-              1e-6);
-  EXPECT_NEAR(session.bridge_adjustment_priors()[1].information(1, 1), InverseSquare(0.625),
-              1e-9);
+  EXPECT_NEAR(session.bridge_adjustment_priors()[0].information(0, 0), InverseSquare(0.0625), 1e-6);
+  EXPECT_NEAR(session.bridge_adjustment_priors()[1].information(1, 1), InverseSquare(0.625), 1e-9);
   EXPECT_NEAR(session.bridge_adjustment_priors()[1].information(4, 4), InverseSquare(1.05), 1e-9);
 }
 
@@ -104,8 +101,9 @@ void BridgeToFirstKeyframe(MapSession& session, BridgedRoute& scene) {
 }
 
 double CentreDistance(const Map& map, KeyframeId keyframe, const Eigen::Vector3d& centre) {
-  return map.Read(
-      [&](const MapData& data) { return (data.FindKeyframe(keyframe)->CameraCenter() - centre).norm(); });
+  return map.Read([&](const MapData& data) {
+    return (data.FindKeyframe(keyframe)->CameraCenter() - centre).norm();
+  });
 }
 
 TEST(MapSessionBridge, CorrectionPullsTheFirstKeyframeTowardsThePredictionAndHoldsIt) {
