@@ -82,7 +82,7 @@ void System::ResetMap() {
 
 bool System::CloseMap() {
   const std::size_t keyframes = map_->NumKeyframes();
-  switch (map_session_.Closing(keyframes, world_aligned_)) {
+  switch (map_session_.DecideClosing(keyframes, world_aligned_)) {
     case MapClosing::kNothing:
     case MapClosing::kDiscarded:  // not in the world frame: ResetMap drops its poses
       return false;

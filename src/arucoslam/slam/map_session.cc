@@ -51,7 +51,7 @@ bool MapSession::LostTooLong(double timestamp_s) {
   return timestamp_s - *lost_since_s_ >= options_.new_map_after_lost_s;
 }
 
-MapClosing MapSession::Closing(std::size_t num_keyframes, bool world_aligned) {
+MapClosing MapSession::DecideClosing(std::size_t num_keyframes, bool world_aligned) {
   if (num_keyframes == 0) return MapClosing::kNothing;
   if (!marker_world_) {
     // Keypoints only: maps are in unrelated frames; the biggest one is the output.

@@ -136,8 +136,11 @@ class MapSession {
   // A frame was tracked: the loss, if any, is over.
   void OnTrackedFrame();
 
-  // Closing (map_session.cc), when the map is about to be replaced.
-  MapClosing Closing(std::size_t num_keyframes, bool world_aligned);
+  // Closing (map_session.cc), when the map is about to be replaced: what is kept of it (an
+  // unaligned map in the marker world is counted as discarded).
+  MapClosing DecideClosing(std::size_t num_keyframes, bool world_aligned);
+  // Keypoints only, after kBiggestKeypointMap: the closing map's frame `poses` (its own frame)
+  // are the output until a bigger map comes.
   void KeepBiggestKeypointMap(std::vector<StampedPose> poses, std::size_t num_keyframes);
   // The world-aligned `map` closes: its outputs are kept and, with merge_closed_maps, the map
   // itself until the next map is in the world. True when it is kept for a merge.

@@ -87,10 +87,10 @@ TEST(MapSession, LoadedMapIsKeptHoweverLongTheLoss) {
 
 TEST(MapSession, KeypointMapsKeepTheBiggestClosedOneAsOutput) {
   MapSession session({}, /*marker_world=*/false);
-  EXPECT_EQ(session.Closing(0, false), MapClosing::kNothing);
-  ASSERT_EQ(session.Closing(8, false), MapClosing::kBiggestKeypointMap);
+  EXPECT_EQ(session.DecideClosing(0, false), MapClosing::kNothing);
+  ASSERT_EQ(session.DecideClosing(8, false), MapClosing::kBiggestKeypointMap);
   session.KeepBiggestKeypointMap(Stamped(40), 8);
-  EXPECT_EQ(session.Closing(6, false), MapClosing::kNothing);
+  EXPECT_EQ(session.DecideClosing(6, false), MapClosing::kNothing);
   const std::vector<StampedPose>* output = session.BiggerClosedMapPoses(6);
   ASSERT_NE(output, nullptr);
   EXPECT_EQ(output->size(), 40u);
@@ -99,8 +99,8 @@ TEST(MapSession, KeypointMapsKeepTheBiggestClosedOneAsOutput) {
 
 TEST(MapSession, MarkerWorldDiscardsUnalignedMapsAndClosesAlignedOnes) {
   MapSession session({}, /*marker_world=*/true);
-  EXPECT_EQ(session.Closing(8, /*world_aligned=*/false), MapClosing::kDiscarded);
-  EXPECT_EQ(session.Closing(8, /*world_aligned=*/true), MapClosing::kInWorld);
+  EXPECT_EQ(session.DecideClosing(8, /*world_aligned=*/false), MapClosing::kDiscarded);
+  EXPECT_EQ(session.DecideClosing(8, /*world_aligned=*/true), MapClosing::kInWorld);
   EXPECT_EQ(session.stats().num_maps_discarded, 1);
   EXPECT_EQ(session.BiggerClosedMapPoses(0), nullptr);
 }
