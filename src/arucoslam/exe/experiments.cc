@@ -72,7 +72,7 @@ void Evaluate(const Trajectory& gt, const Trajectory& est, bool with_sim3, Exper
 void AddSlamResults(const SlamRunResult& result, const fs::path& sequence,
                     const std::optional<TrajectoryEvaluation>& evaluation, ExperimentRun& run) {
   run.losses = result.stats.losses;
-  run.new_maps = result.timing.num_new_maps_after_loss;
+  run.new_maps = result.timing.map_session.num_new_maps_after_loss;
   run.keyframes = static_cast<int>(result.keyframes.size());
   run.keyframe_poses = result.keyframes;
   const fs::path world = sequence / "world.sdf";
@@ -135,8 +135,8 @@ ExperimentRun MarkerSlamRun(const fs::path& sequence, const fs::path& out_dir,
       result.stats.frames_tracked, result.stats.frames, result.timing.num_marker_only_poses,
       result.timing.num_unposed_without_markers, result.stats.losses, result.timing.num_marker_relocalizations,
       result.timing.num_world_alignments, result.timing.num_marker_initializations,
-      result.timing.num_new_maps_after_loss, result.timing.num_maps_discarded,
-      result.stats.keyframes, result.stats.map_points,
+      result.timing.map_session.num_new_maps_after_loss,
+      result.timing.map_session.num_maps_discarded, result.stats.keyframes, result.stats.map_points,
       options.marker_mapping.ground_plane_prior
           ? "; ground-vehicle prior (keyframes held near one camera height and tilt in the "
             "whole-map adjustment)"
@@ -163,7 +163,8 @@ ExperimentRun KeypointSlamRun(const std::string& label, const std::string& seque
       "{} of {} frames tracked, {} losses, {} new maps after a loss (the output is the map "
       "with the most keyframes), {} keyframes, {} map points in the last map",
       result.stats.frames_tracked, result.stats.frames, result.stats.losses,
-      result.timing.num_new_maps_after_loss, result.stats.keyframes, result.stats.map_points);
+      result.timing.map_session.num_new_maps_after_loss, result.stats.keyframes,
+      result.stats.map_points);
   Evaluate(dataset.ground_truth(), result.trajectory, /*with_sim3=*/true, run);
   run.in_world_frame = false;
   AddSlamResults(result, sequence, run.sim3, run);

@@ -223,7 +223,7 @@ TEST_F(PlacesEndToEnd, TrackingResumesWithinOneSecondAfterATwoSecondGap) {
               *first_after - back_s, run.stats.places.num_relocalizations, run.ate_m,
               reference.ate_m);
   EXPECT_LE(*first_after - back_s, 1.0);
-  EXPECT_EQ(run.stats.num_resets, 0);
+  EXPECT_EQ(run.stats.map_session.num_resets, 0);
   EXPECT_GE(run.trajectory.size(), 0.9 * (dataset.size() - (gap_end - gap_begin)));
   // One Sim(3) for the poses before and after the gap: a jump at the gap would show here.
   EXPECT_LT(run.ate_m, 0.15);

@@ -44,7 +44,7 @@ SlamRunStats MakeStats(const std::string& dataset_label, const FrameSource& sour
   out.global_bundle_adjustments = stats.places.num_global_bundle_adjustments;
   out.initialization_attempts = stats.num_initialization_attempts;
   out.initializations = stats.num_initializations;
-  out.resets = stats.num_resets;
+  out.resets = stats.map_session.num_resets;
   out.keyframes_inserted = stats.num_keyframes_inserted;
   out.keyframes = static_cast<int>(system.map().NumKeyframes());
   out.map_points = static_cast<int>(system.map().NumMapPoints());
@@ -62,7 +62,7 @@ SlamRunStats MakeStats(const std::string& dataset_label, const FrameSource& sour
   out.marker_rejections = stats.marker_fusion.num_rejected_poses;
   out.drift_beyond_gate = stats.marker_fusion.num_drift_disagreements;
   out.whole_map_marker_adjustments = stats.num_whole_map_marker_adjustments;
-  out.map_merges = stats.num_map_merges;
+  out.map_merges = stats.map_session.num_map_merges;
   out.wall_time_s = wall_time_s;
   out.peak_memory_bytes = PeakMemoryBytes();
   out.timings_ms = {{"extraction", stats.extraction_ms.Summarize()},

@@ -50,8 +50,8 @@ void VisitOptions(SystemOptions& o, Visitor& visit) {
         "threaded, marker map: ... and while the map is not aligned to the marker world");
   visit("max_initialization_gap_s", o.max_initialization_gap_s,
         "the initialisation reference is replaced after this long, seconds");
-  visit("reset_max_keyframes", o.reset_max_keyframes,
-        "lost with at most this many keyframes: the map is discarded and initialised again");
+  visit("map_session", o.map_session,
+        "lost maps: reset, closed, merged into the next map, the gap bridged; the backfill");
   visit("detector", o.detector, "marker detection (with a marker map)");
   visit("marker_search", o.marker_search, "where each image's markers are searched");
   visit("marker_fusion", o.marker_fusion,
@@ -71,15 +71,11 @@ void VisitOptions(SystemOptions& o, Visitor& visit) {
         "realigned each time the anchors double, up to this many");
   visit("min_frames_between_anchor_keyframes", o.min_frames_between_anchor_keyframes,
         "before alignment a frame with a marker location becomes a keyframe after this many");
-  visit("marker_reset_lost_frames", o.marker_reset_lost_frames,
-        "aligned map lost this many frames while markers give poses: a new map");
   visit("markers_in_local_ba", o.markers_in_local_ba,
         "aligned map: marker observations in local and global BA");
   visit("map_unknown_markers", o.map_unknown_markers, "aligned map: map markers it lacks");
   visit("whole_map_marker_adjustment", o.whole_map_marker_adjustment,
         "aligned map: one BA of the whole map with the markers when it closes and at Finish");
-  visit("merge_closed_maps", o.merge_closed_maps,
-        "a closed aligned map is merged into the next map once that one is aligned");
   visit("min_locating_marker_keyframes", o.min_locating_marker_keyframes,
         "mapped markers seen by this many keyframes locate frames (0: never)");
   visit("marker_mapping", o.marker_mapping, "mapping of markers absent from the marker map");
@@ -94,30 +90,11 @@ void VisitOptions(SystemOptions& o, Visitor& visit) {
   visit("marker_priors", o.marker_priors, "keyframe marker locations as priors");
   visit("marker_correction_graph", o.marker_correction_graph,
         "the pose graph of marker corrections");
-  visit("bridge_tracking_gaps", o.bridge_tracking_gaps,
-        "a gap between two aligned maps bridged by a constant-velocity prediction");
-  visit("bridge_motion", o.bridge_motion, "that prediction");
-  visit("bridge_position_sigma_m", o.bridge_position_sigma_m,
-        "its position sigma, metres, plus ...");
-  visit("bridge_position_sigma_per_s", o.bridge_position_sigma_per_s,
-        "... this per second of gap, metres per second");
-  visit("bridge_rotation_sigma_rad", o.bridge_rotation_sigma_rad,
-        "its rotation sigma, radians, plus ...");
-  visit("bridge_rotation_sigma_per_s", o.bridge_rotation_sigma_per_s,
-        "... this per second of gap, radians per second");
-  visit("bridge_in_bundle_adjustment", o.bridge_in_bundle_adjustment,
-        "the bridge's camera centre stays a prior in whole-map bundle adjustments");
-  visit("bridge_max_acceleration_m_s2", o.bridge_max_acceleration_m_s2,
-        "its sigma there grows with this x gap^2 / 2, metres per second squared");
   visit("places", o.places, "place recognition: relocalisation and loops (with a vocabulary)");
-  visit("new_map_after_lost_s", o.new_map_after_lost_s,
-        "lost this long and not relocalised: a new map, seconds");
   visit("min_marker_init_baseline_m", o.min_marker_init_baseline_m,
         "marker initialisation: two marker locations at least this far apart, metres");
   visit("min_marker_init_parallax_deg", o.min_marker_init_parallax_deg,
         "... and this median parallax of the triangulated points, degrees");
-  visit("max_backfill_frames", o.max_backfill_frames,
-        "frames before initialisation tracked backwards against the new map (0: none)");
   visit("refine_frame_poses", o.refine_frame_poses,
         "at Finish every tracked frame is optimised again against the final map");
   visit("refine_min_inlier_fraction", o.refine_min_inlier_fraction,

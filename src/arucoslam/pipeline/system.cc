@@ -38,7 +38,7 @@ bool SystemOptions::Check(std::string* why) const {
   check.Nested("mapper", mapper);
   check.AtLeast("mapper_queue_capacity", mapper_queue_capacity, 1);
   check.Above("max_initialization_gap_s", max_initialization_gap_s, 0.0);
-  check.AtLeast("reset_max_keyframes", reset_max_keyframes, 0);
+  check.Nested("map_session", map_session);
   check.Nested("pose_consistency", pose_consistency);
   check.AtLeast("synchronous_young_map_keyframes", synchronous_young_map_keyframes, 0);
   check.Nested("detector", detector);
@@ -48,24 +48,16 @@ bool SystemOptions::Check(std::string* why) const {
   check.AtLeast("min_alignment_baseline_m", min_alignment_baseline_m, 0.0);
   check.Above("max_alignment_rms_m", max_alignment_rms_m, 0.0);
   check.Above("max_alignment_scale", max_alignment_scale, 0.0);
-  check.AtLeast("marker_reset_lost_frames", marker_reset_lost_frames, 1);
   check.AtLeast("max_realignment_anchors", max_realignment_anchors, min_alignment_anchors,
                 "min_alignment_anchors");
   check.Nested("places", places);
   check.AtLeast("min_frames_between_anchor_keyframes", min_frames_between_anchor_keyframes, 0);
   check.Nested("marker_mapping", marker_mapping);
-  check.Above("new_map_after_lost_s", new_map_after_lost_s, 0.0);
   check.Above("min_marker_init_baseline_m", min_marker_init_baseline_m, 0.0);
   check.AtLeast("min_marker_init_parallax_deg", min_marker_init_parallax_deg, 0.0);
   check.Nested("marker_search", marker_search);
   check.InRange("refine_min_inlier_fraction", refine_min_inlier_fraction, 0.0, 1.0,
                 Interval::kOpenClosed);
-  check.Nested("bridge_motion", bridge_motion);
-  check.Above("bridge_position_sigma_m", bridge_position_sigma_m, 0.0);
-  check.AtLeast("bridge_position_sigma_per_s", bridge_position_sigma_per_s, 0.0);
-  check.AtLeast("bridge_max_acceleration_m_s2", bridge_max_acceleration_m_s2, 0.0);
-  check.Above("bridge_rotation_sigma_rad", bridge_rotation_sigma_rad, 0.0);
-  check.AtLeast("bridge_rotation_sigma_per_s", bridge_rotation_sigma_per_s, 0.0);
   return check.ok();
 }
 
@@ -74,7 +66,8 @@ System::System(const CameraModel& camera, const SystemOptions& options)
       options_(options),
       extractor_(options.extractor),
       initializer_(options.initializer),
-      marker_fusion_(MakeMarkerFusion(options, camera)) {
+      marker_fusion_(MakeMarkerFusion(options, camera)),
+      map_session_(options.map_session, options.marker_map.has_value()) {
   if (std::string why; !options_.Check(&why)) {
     throw std::invalid_argument("System: invalid SystemOptions: " + why);
   }
@@ -272,6 +265,7 @@ FrameReport System::ProcessFrame(Frame frame, const std::vector<MarkerDetection>
     }
     stats_.tracking_ms.Add(watch.ElapsedMilliseconds());
     stats_.marker_fusion = marker_fusion_.stats();
+    stats_.map_session = map_session_.stats();
   }
   if (pending_keyframe_) {
     MapKeyframe(*pending_keyframe_);
@@ -285,11 +279,7 @@ void System::Initialize(Frame& frame, FrameReport& report) {
   const bool enough = report.num_features >= options_.initializer.min_matches;
   if (!init_reference_ ||
       frame.timestamp_s - init_reference_->timestamp_s > options_.max_initialization_gap_s) {
-    if (enough) {
-      KeepForBackfill();
-      init_reference_ = frame;
-      init_reference_fix_ = marker_fusion_.fix();
-    }
+    if (enough) ReplaceInitReference(frame);
     report.message = enough ? "initialisation reference" : "too few features";
     return;
   }
@@ -306,11 +296,9 @@ void System::Initialize(Frame& frame, FrameReport& report) {
                       result.message);
   if (!result.success) {
     if (result.failure == InitFailure::kTooFewMatches && enough) {
-      KeepForBackfill();
-      init_reference_ = frame;
-      init_reference_fix_ = marker_fusion_.fix();
+      ReplaceInitReference(frame);
     } else {
-      KeepForBackfill(frame);
+      map_session_.KeepForBackfill(frame);
     }
     return;
   }
@@ -344,7 +332,7 @@ void System::FinishInitialization(Frame& first, Frame& frame, KeyframeId first_i
     places_->KeyframeMapped(first_id);
     places_->KeyframeMapped(second_id);
   }
-  AddBridgePrior(first_id, first.timestamp_s);
+  map_session_.AddBridgePrior(first_id, first.timestamp_s, world_aligned_);
   AddAnchor(first_id, init_reference_fix_);
   AddAnchor(second_id, marker_fusion_.fix());
   init_reference_fix_.reset();
@@ -393,30 +381,12 @@ void System::Track(Frame& frame, FrameReport& report) {
     report.message = "tracking lost";
     ARUCOSLAM_LOG_DEBUG("frame {}: tracking lost ({} keyframes in the map)", report.index,
                         map_->NumKeyframes());
-    // A map aligned to the world is kept (markers relocalise into it) unless marker poses
-    // keep coming and it does not take them back.
-    const bool stuck = fix && ++lost_with_markers_ >= options_.marker_reset_lost_frames;
-    const bool young = static_cast<int>(map_->NumKeyframes()) <= options_.reset_max_keyframes;
-    if (map_loaded_) return;  // a loaded map is kept: frames relocalise into it
-    KeepLostFrame(frame);
-    if (LostTooLong(frame)) {
-      ARUCOSLAM_LOG_DEBUG("frame {}: lost for {:.1f} s, starting a new map", report.index,
-                          options_.new_map_after_lost_s);
-      {
-        std::lock_guard lock(stats_mutex_);
-        ++stats_.num_new_maps_after_loss;
-      }
-      ResetMap();
-    } else if (stuck || (young && !world_aligned_)) {
-      ResetMap();
-    }
+    HandleLostFrame(frame, report.index);
     return;
   }
   last_state_ = TrackingState::kTracking;
-  lost_frames_.clear();
+  map_session_.OnTrackedFrame();
   marker_fusion_.NoteTrackedFrame(frame, relocalized, world_aligned_);
-  lost_with_markers_ = 0;
-  lost_since_s_.reset();
   ++frames_since_keyframe_;
   MaybeInsertKeyframe(frame, result.num_inliers, report);
   report.cam_from_world = frame.cam_from_world;
@@ -476,6 +446,10 @@ void System::MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& rep
 }
 
 void System::RecordPose(const Frame& frame, KeyframeId reference) {
+  poses_.push_back(MakeTrackedPose(frame, reference));
+}
+
+System::TrackedPose System::MakeTrackedPose(const Frame& frame, KeyframeId reference) const {
   TrackedPose pose;
   pose.timestamp_s = frame.timestamp_s;
   pose.reference = reference;
@@ -505,80 +479,16 @@ void System::RecordPose(const Frame& frame, KeyframeId reference) {
     }
     if (world_aligned_ && fix && fix->known_markers_only) pose.markers = fix->markers;
   }
-  poses_.push_back(std::move(pose));
-}
-
-void System::ResetMap() {
-  StopMappingThread();
-  const bool kept_for_merge = CloseMap();
-  // Poses already in the world frame stay, frozen at their current estimate (those of a map
-  // kept for a merge remember their keyframe there).
-  std::vector<TrackedPose> kept;
-  map_->Read([&](const MapData& data) {
-    for (TrackedPose pose : poses_) {
-      if (!pose.in_world && pose.marker_cam_from_world) {  // frozen at its marker location
-        pose.cam_from_world = *pose.marker_cam_from_world;
-        pose.cam_from_reference = pose.cam_from_world;
-        pose.reference = KeyframeId();
-        pose.in_world = true;
-      }
-      if (!pose.in_world) continue;
-      if (kept_for_merge) pose.closed_reference = KeyframeId();  // an older closed map's
-      if (const Keyframe* reference = data.FindKeyframe(pose.reference)) {
-        pose.cam_from_world = PoseFromReference(pose, reference->cam_from_world);
-        if (kept_for_merge) pose.closed_reference = pose.reference;
-      }
-      pose.reference = KeyframeId();
-      if (!pose.closed_reference.IsValid()) {  // frozen for good: never refined
-        pose.matches = {};
-        pose.markers = {};
-      }
-      kept.push_back(std::move(pose));
-    }
-    return 0;
-  });
-  places_.reset();
-  tracker_.reset();
-  mapper_.reset();
-  map_ = std::make_unique<Map>();
-  tracker_ = std::make_unique<Tracker>(*map_, options_.tracker);
-  MakeLocalMapper();
-  MakePlaceRecognition();
-  HoldBridgePriors({});  // the new places hold none yet; the marker mapper drops them
-  const int marker_generation = ResetMarkerMapping();
-  if (kept_for_merge) closed_map_->marker_generation = marker_generation;
-  poses_ = std::move(kept);
-  init_reference_.reset();
-  // The frames lost before the reset are the oldest the next map's backfill tries.
-  initialisation_frames_ = std::move(lost_frames_);
-  lost_frames_.clear();
-  init_reference_fix_.reset();
-  anchors_.clear();
-  {
-    std::lock_guard lock(keyframe_fixes_mutex_);
-    keyframe_fixes_.clear();
-  }
-  next_alignment_anchors_ = 0;
-  world_aligned_ = false;
-  marker_fusion_.MapReset();
-  absorbed_keyframes_.clear();
-  bridge_priors_.clear();
-  bridge_adjustment_priors_.clear();
-  lost_with_markers_ = 0;
-  lost_since_s_.reset();
-  last_state_ = TrackingState::kNotInitialized;
-  mapping_busy_ = false;
-  StartMappingThread();
-  std::lock_guard lock(stats_mutex_);
-  ++stats_.num_resets;
+  return pose;
 }
 
 std::vector<StampedPose> System::Trajectory() const { return CheckedTrajectory(nullptr); }
 
 std::vector<StampedPose> System::CheckedTrajectory(int* num_dropped) const {
   if (num_dropped != nullptr) *num_dropped = 0;
-  if (!options_.marker_map && map_->NumKeyframes() < biggest_closed_keyframes_) {
-    return biggest_closed_poses_;
+  if (const std::vector<StampedPose>* closed =
+          map_session_.BiggerClosedMapPoses(map_->NumKeyframes())) {
+    return *closed;
   }
   std::vector<StampedPose> poses = CurrentMapPoses(/*world_only=*/options_.marker_map.has_value());
   // A loaded map's keyframes were timed in another run: they do not bracket these frames.
@@ -607,7 +517,7 @@ std::vector<StampedPose> System::CurrentMapPoses(bool world_only) const {
 }
 
 std::vector<StampedPose> System::KeyframePoses() const {
-  std::vector<StampedPose> poses = closed_keyframes_;
+  std::vector<StampedPose> poses = map_session_.closed_keyframes();
   if (!options_.marker_map || world_aligned_) {  // else the map is not in the world frame
     map_->Read([&](const MapData& data) {
       for (const auto& [id, keyframe] : data.keyframes()) {
@@ -624,7 +534,7 @@ std::vector<StampedPose> System::KeyframePoses() const {
 }
 
 std::vector<Eigen::Vector3d> System::MapPoints() const {
-  std::vector<Eigen::Vector3d> points = closed_points_;
+  std::vector<Eigen::Vector3d> points = map_session_.closed_points();
   if (options_.marker_map && !world_aligned_) return points;  // not in the world frame
   map_->Read([&](const MapData& data) {
     for (const auto& [id, point] : data.map_points()) points.push_back(point.p_in_world);

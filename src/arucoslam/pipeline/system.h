@@ -12,14 +12,12 @@
 #include <memory>
 #include <mutex>
 #include <optional>
-#include <set>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "arucoslam/feature/orb_extractor.h"
 #include "arucoslam/geometry/pose_consistency.h"
-#include "arucoslam/geometry/world_motion_prior.h"
 #include "arucoslam/map/map.h"
 #include "arucoslam/markers/camera_locator.h"
 #include "arucoslam/markers/detector.h"
@@ -34,6 +32,7 @@
 #include "arucoslam/slam/keyframe_policy.h"
 #include "arucoslam/slam/local_mapper.h"
 #include "arucoslam/slam/map_initialization.h"
+#include "arucoslam/slam/map_session.h"
 #include "arucoslam/slam/marker_fusion.h"
 #include "arucoslam/slam/marker_mapper.h"
 #include "arucoslam/slam/tracker.h"
@@ -69,9 +68,9 @@ struct SystemOptions {
   // many seconds later (a reference is also replaced when too few matches are left). Long
   // enough for a vehicle that starts from rest to build up parallax.
   double max_initialization_gap_s = 3.0;
-  // Tracking lost while the map holds at most this many keyframes: the map is discarded and
-  // initialisation starts over (a young map is cheaper to rebuild than to recover).
-  int reset_max_keyframes = 5;
+  // What becomes of a map that lost tracking (reset, closed, merged into the next one, the
+  // gap bridged) and how many frames a new map's backfill tracks (slam/map_session.h).
+  MapSessionOptions map_session;
 
   // Known markers (markers.json). When set, markers are detected in every image and located
   // (LocateCamera): frames without a keypoint pose get the marker pose, the keypoint map is
@@ -119,10 +118,6 @@ struct SystemOptions {
   // Until the first alignment, a frame with a usable marker location becomes a keyframe when
   // at least this many frames passed since the last keyframe.
   int min_frames_between_anchor_keyframes = 1;
-  // Aligned map, tracking lost for this many frames in a row while markers give poses but
-  // the map does not take them back: the map is discarded and a new one initialised and
-  // aligned (the poses already output are kept).
-  int marker_reset_lost_frames = 10;
   // Once the map is world-aligned, keyframes' marker observations join local BA and the
   // global BA after a loop (known markers fixed) and markers the map lacks are mapped
   // (system_marker_mapping.cc).
@@ -133,10 +128,6 @@ struct SystemOptions {
   // keyframes kept) when it is closed after a loss and at Finish (corner weights:
   // MarkerMapperOptions). false: at Finish only the mapped markers are refined.
   bool whole_map_marker_adjustment = true;
-  // A world-aligned map closed after a loss is kept whole and merged into the next map as
-  // soon as that one is in the world too (one map again: relocalisation and loops reach the
-  // old places, --save-map and the final adjustment hold both). false: its poses are frozen.
-  bool merge_closed_maps = true;
   // Mapped markers seen by at least this many keyframes locate frames like known ones
   // (marker poses and relocalisation where the known map has no marker). 0: never.
   int min_locating_marker_keyframes = 3;
@@ -175,49 +166,16 @@ struct SystemOptions {
     return graph;
   }();
 
-  // Bridge over a tracking gap (system_bridge.cc): when a world-aligned map is closed after
-  // a loss, the camera's motion over its last bridge_motion.max_span_s predicts (constant
-  // velocity) the world pose of the next map's first keyframe, if that keyframe comes at
-  // most bridge_motion.max_age_s after the last pose. The prediction is a prior of that
-  // keyframe in a pose-graph correction once the two maps are merged in the world (the
-  // absorbed map held): the new map's stretch before its first marker then lies between two
-  // constraints. Standard deviations: bridge_position_sigma_m + bridge_position_sigma_per_s
-  // * gap (metres), and the same for rotation (radians; a turn in the gap is not predicted).
-  // 0.1 m per second: a robot at 0.7 m/s turning at 0.4 rad/s it did not before strays
-  // 0.14 m from the straight line in a second.
-  bool bridge_tracking_gaps = true;
-  WorldMotionPriorOptions bridge_motion{.max_age_s = 3.0, .min_span_s = 0.3, .max_span_s = 1.0};
-  double bridge_position_sigma_m = 0.025;
-  double bridge_position_sigma_per_s = 0.1;
-  double bridge_rotation_sigma_rad = 0.05;
-  double bridge_rotation_sigma_per_s = 0.5;
-  // After that correction the bridge's predicted camera centre stays a prior of the keyframe
-  // in every bundle adjustment of the whole map (global BA after a loop, the whole-map
-  // adjustment with markers), so that these no longer forget it. Its sigma there is
-  // bridge_position_sigma_m + bridge_max_acceleration_m_s2 * gap^2 / 2: how far a vehicle
-  // can stray from the prediction (the pose graph's tighter sigma pulled a right map towards
-  // a wrong prediction: system_recovery_test).
-  bool bridge_in_bundle_adjustment = true;
-  double bridge_max_acceleration_m_s2 = 0.3;
-
   // Bag-of-words vocabulary. When set, keyframes enter a place database: lost tracking is
   // relocalised from it and, with places.loop_closing, loops are closed. Null: neither.
   std::shared_ptr<const Vocabulary> vocabulary;
   PlaceRecognitionOptions places;
-  // Tracking lost for this long (seconds) and not relocalised: a new map is started (the
-  // old one is closed; see System::Trajectory for which poses are kept).
-  double new_map_after_lost_s = 1.0;
   // Marker initialisation: when the initialisation reference and the current frame both
   // have a usable marker location with centres at least this far apart (metres), the
   // matches are triangulated with the markers' relative pose and the map starts in the world.
   double min_marker_init_baseline_m = 0.5;
   // ... and at least this median parallax of the triangulated points (degrees).
   double min_marker_init_parallax_deg = 1.0;
-  // Frames between the initialisation reference and the frame that initialised the map
-  // (the camera building up parallax), and before them the frames the previous map lost
-  // before it was reset, are tracked backwards against the new map and get poses too (up to
-  // this many, the newest kept). 0: they stay without a keypoint pose.
-  int max_backfill_frames = 150;
   // At Finish, after the last map adjustments, every frame tracked in the map is optimised
   // again (motion only) against the final positions of the map points it matched when it
   // was tracked, plus the known markers it saw, starting from its pose relative to its
@@ -274,7 +232,6 @@ struct SystemStats {
   int num_losses = 0;            // transitions tracking -> lost
   int num_initialization_attempts = 0;
   int num_initializations = 0;
-  int num_resets = 0;
   int num_keyframes_inserted = 0;
   TimingStats marker_ms;          // per frame with a marker map: detection and location
   // Per frame with a marker map: what the frame waits for markers (detection runs during
@@ -289,14 +246,11 @@ struct SystemStats {
   int num_marker_relocalizations = 0;  // tracking restarted from a marker pose
   int num_map_relocalizations = 0;     // loaded map: restarted from a keyframe match
   PlaceRecognitionStats places;        // relocalisation and loops (with a vocabulary)
-  int num_new_maps_after_loss = 0;     // maps started because tracking stayed lost
   int num_marker_initializations = 0;  // maps initialised from two marker locations
-  int num_maps_discarded = 0;          // closed maps never aligned (marker map only)
+  MapSessionStats map_session;         // resets, closed maps, merges and bridged gaps
   int num_marker_corrections = 0;      // pose-graph corrections of drift by markers
   int num_whole_map_marker_adjustments = 0;  // bundle adjustments of a whole map with markers
-  int num_map_merges = 0;  // closed maps absorbed by a later map in the world
   int num_refined_frame_poses = 0;  // frames re-optimised against the final map at Finish
-  int num_bridged_gaps = 0;         // merged maps corrected with a bridge over their gap
   int num_yielded_bundle_adjustments = 0;  // local BAs ended early for a waiting keyframe
   int num_inconsistent_poses = 0;   // frames left out of Trajectory (pose_consistency)
 };
@@ -445,32 +399,41 @@ class System {
   std::shared_ptr<const MarkerMap> LocatingMarkers() const;
   void MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& report);
   void MapKeyframe(KeyframeId keyframe);
+  // A frame's tracked pose against its reference keyframe, with what tracking matched in it
+  // (refine_frame_poses), and the same added to poses_.
+  TrackedPose MakeTrackedPose(const Frame& frame, KeyframeId reference) const;
   void RecordPose(const Frame& frame, KeyframeId reference);
+  // Map sessions (system_map_session.cc): map_session_'s decisions carried out on the map,
+  // the poses, the marker mapper and the place recognition.
+  // A lost frame (`frame_index` for the log): the map is kept, or reset as map_session_ says.
+  void HandleLostFrame(const Frame& frame, std::size_t frame_index);
+  // Replaces the map by an empty one; the poses in the world stay, frozen (those of a map
+  // kept for a merge remember their keyframe there).
   void ResetMap();
-  // Recovery and marker initialisation (system_recovery.cc).
-  // Called on a lost frame: true when the loss has lasted new_map_after_lost_s.
-  bool LostTooLong(const Frame& frame);
-  // Keeps what must outlive the current map before it is discarded (ResetMap); true when
-  // the map is kept whole for a merge (closed_map_).
+  // Before ResetMap discards the map: map_session_ keeps what must outlive it; true when the
+  // map is kept whole for a merge.
   bool CloseMap();
-  // Once the current map is in the world: the closed map joins it (MapData::Absorb), with
-  // its frozen poses, marker views, marker priors and place-database entries. Called with
-  // the mapping thread stopped and the places' edit lock held. True when it merged.
+  // Once the current map is in the world: the closed map joins it, with its frozen poses,
+  // marker views, marker priors and place-database entries. Called with the mapping thread
+  // stopped and the places' edit lock held. True when it merged.
   bool MergeClosedMap();
-  // Builds the initial map from the marker poses of the reference and `frame` directly in
-  // the world; false when the marker poses do not allow it (the caller initialises as usual).
+  // Once the closed map is merged: the new map corrected across the tracking gap.
+  void CorrectAcrossBridge();
+  // Hands map_session_'s held bridge priors to the marker mapper and the place recognition;
+  // the caller holds the places' edit lock (LockPlacesForMapMove) or has just made them anew.
+  void HandOutBridgePriors();
+  // `frame` becomes the initialisation reference, with its marker location; the reference it
+  // replaces is kept for the backfill.
+  void ReplaceInitReference(const Frame& frame);
+  // The frames kept for the backfill, tracked from `second` back in time: each one tracked
+  // gets a pose, in place of a marker-only pose of the same frame.
+  void BackfillInitialization(const Frame& second, KeyframeId first_id, KeyframeId second_id);
+  // Marker initialisation (system_marker_initialization.cc): builds the initial map from the
+  // marker poses of the reference and `frame` directly in the world; false when the marker
+  // poses do not allow it (the caller initialises as usual).
   bool InitializeFromMarkers(Frame& frame, FrameReport& report);
   void FinishInitialization(Frame& first, Frame& frame, KeyframeId first_id,
                             KeyframeId second_id, int num_points, FrameReport& report);
-  // The frames kept in initialisation_frames_, tracked from `second` back in time with a
-  // tracker of their own: each one tracked gets a pose (system_backfill.cc).
-  void BackfillInitialization(const Frame& second, KeyframeId first_id, KeyframeId second_id);
-  // Keeps `frame` (or, without one, the reference about to be replaced) for the backfill;
-  // the oldest frames go beyond max_backfill_frames.
-  void KeepForBackfill(const std::optional<Frame>& frame = std::nullopt);
-  // Keeps a frame lost by the current map: when the map is reset, the next one's backfill
-  // goes on back through them (up to max_backfill_frames in all).
-  void KeepLostFrame(const Frame& frame);
   // Trajectory, and how many poses drop_inconsistent_poses left out (null: not counted).
   std::vector<StampedPose> CheckedTrajectory(int* num_dropped) const;
   // Poses of the current map in its own frame (reference keyframes' final poses).
@@ -487,8 +450,6 @@ class System {
   std::unique_ptr<Tracker> tracker_;
   std::unique_ptr<LocalMapper> mapper_;
   std::optional<Frame> init_reference_;
-  std::vector<Frame> initialisation_frames_;  // after init_reference_, for the backfill
-  std::vector<Frame> lost_frames_;            // of the current loss, for the next backfill
   std::size_t num_frames_ = 0;
   int frames_since_keyframe_ = 0;
   TrackingState last_state_ = TrackingState::kNotInitialized;
@@ -516,44 +477,8 @@ class System {
   // waiting keyframe (yield_bundle_adjustment).
   void MakeLocalMapper();
   int next_alignment_anchors_ = 0;  // alignment is tried again at this many anchors
-  int lost_with_markers_ = 0;
-  std::optional<double> lost_since_s_;  // timestamp of the first lost frame of this loss
-  // Closed maps: keypoints only, the biggest one's poses; with markers, the aligned ones'
-  // keyframes and points (their poses stay in poses_, frozen).
-  std::vector<StampedPose> biggest_closed_poses_;
-  std::size_t biggest_closed_keyframes_ = 0;
-  std::vector<StampedPose> closed_keyframes_;
-  std::vector<Eigen::Vector3d> closed_points_;
-  // The last world-aligned map closed after a loss, kept whole until the next map is in the
-  // world and absorbs it; the output lists above end with its keyframes and points.
-  struct ClosedMap {
-    MapData data;
-    int marker_generation = -1;  // MarkerMapper::CloseMap's
-    std::map<KeyframeId, MarkerFix> keyframe_fixes;
-    std::size_t output_keyframes_before = 0;  // closed_keyframes_ entries of older maps
-    std::size_t output_points_before = 0;
-  };
-  std::optional<ClosedMap> closed_map_;
-  // Bridge over the gap between the closed map and the current one (system_bridge.cc): the
-  // closed map's last world poses and the current map's first keyframe's predicted pose.
-  WorldMotionPrior motion_at_close_{options_.bridge_motion};
-  std::vector<KeyframePosePrior> bridge_priors_;
-  std::vector<KeyframePosePrior> bridge_adjustment_priors_;  // the same, adjustment sigma
-  // The bridge priors already applied, kept for the whole-map bundle adjustments
-  // (bridge_in_bundle_adjustment) until the map is reset.
-  std::vector<KeyframePosePrior> held_bridge_priors_;
-  // Hands them to the marker mapper and the place recognition; the caller holds the
-  // places' edit lock (LockPlacesForMapMove) or has just made them anew (ResetMap).
-  void HoldBridgePriors(std::vector<KeyframePosePrior> priors);
-  void RememberMotionAtClose();
-  void AddBridgePrior(KeyframeId keyframe, double timestamp_s);
-  // Once the closed map is merged: the new map corrected by the pose graph with the marker
-  // priors and the bridge priors, the absorbed keyframes held (false: nothing to bridge).
-  bool CorrectAcrossBridge();
-  // Keyframes the current map absorbed from a closed one (already in the world: world
-  // re-alignments leave them in place) and whether a point links them to the rest.
-  std::set<KeyframeId> absorbed_keyframes_;
-  bool LinkedToAbsorbedMap() const;
+  // Lost maps: reset, closed, merged into the next map, the gap bridged; the backfill.
+  MapSession map_session_;
   double detection_ms_ = 0.0;  // marker detection time of the current image
   double marker_wait_ms_ = 0.0;  // the current image's wait for its detections
   // Markers of the world-aligned map; only the mapping thread touches it while it runs.

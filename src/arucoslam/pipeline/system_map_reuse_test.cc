@@ -194,7 +194,7 @@ TEST(SystemMapReuse, LocaliseOnlyRelocalisesAfterABlackout) {
   }
   EXPECT_LT(RmsError(second, truth_from_map), 0.024);
   EXPECT_EQ(second.stats.num_keyframes_inserted, 0);
-  EXPECT_EQ(second.stats.num_resets, 0);
+  EXPECT_EQ(second.stats.map_session.num_resets, 0);
   ExpectSameGeometry(first.map, second.map);
 }
 

@@ -2,6 +2,7 @@
 // poses, relocalisation from a marker pose, and the Sim(3) alignment of the keypoint map to
 // the world.
 #include <algorithm>
+#include <set>
 #include <utility>
 
 #include "arucoslam/pipeline/system.h"
@@ -119,7 +120,8 @@ void System::MaybeAlignWorld(Frame& frame) {
   }
   const Sim3& world_from_map = alignment.world_from_map;
   StopMappingThread();  // every queued keyframe is mapped first; mapping is idle below
-  if (world_aligned_ && !absorbed_keyframes_.empty() && LinkedToAbsorbedMap()) {
+  const std::set<KeyframeId>& absorbed = map_session_.absorbed_keyframes();
+  if (world_aligned_ && !absorbed.empty() && map_session_.LinkedToAbsorbedMap(*map_)) {
     // A merged map that shares points with this one now (a loop, fused points): a
     // re-alignment from this map's anchors alone would tear them apart. Markers correct the
     // map by fusion from here on (drift correction, marker corners in bundle adjustment).
@@ -139,7 +141,7 @@ void System::MaybeAlignWorld(Frame& frame) {
     }
   }
   // A merged map not linked yet stays where it is (already in the world).
-  const std::set<KeyframeId>* stay = absorbed_keyframes_.empty() ? nullptr : &absorbed_keyframes_;
+  const std::set<KeyframeId>* stay = absorbed.empty() ? nullptr : &absorbed;
   const std::unique_lock<std::mutex> places_lock = LockPlacesForMapMove();
   // On a re-alignment the markers mapped in the previous estimate of the world move too.
   MarkerLandmarks* mapped =
@@ -155,7 +157,7 @@ void System::MaybeAlignWorld(Frame& frame) {
     // Marker-only and frozen poses (no reference) are in the world already; on a
     // re-alignment the poses tied to this map's keyframes move with them.
     const bool moves = !pose.in_world || (world_aligned_ && pose.reference.IsValid() &&
-                                           absorbed_keyframes_.count(pose.reference) == 0);
+                                           absorbed.count(pose.reference) == 0);
     if (!moves) continue;
     pose.cam_from_world = to_world(pose.cam_from_world);
     pose.cam_from_reference.translation *= world_from_map.scale;

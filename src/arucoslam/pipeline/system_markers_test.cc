@@ -389,7 +389,7 @@ TEST(SystemMarkers, DriftThatTheMarkersRevealAfterAGapIsCorrectedNotRejected) {
   EXPECT_EQ(run.stats.marker_fusion.num_drift_disagreements, 1);
   EXPECT_EQ(run.stats.marker_fusion.num_rejected_poses, 0);
   EXPECT_GE(run.stats.num_marker_corrections, 1);
-  EXPECT_EQ(run.stats.num_resets, 0);
+  EXPECT_EQ(run.stats.map_session.num_resets, 0);
   ASSERT_TRUE(run.reports[100].cam_from_world);
   EXPECT_FALSE(run.reports[100].marker_pose);
   for (int t = 101; t < 140; ++t) {
@@ -434,7 +434,7 @@ TEST(SystemMarkers, DisagreementGrowingFrameByFrameIsDrift) {
   const DriftRun run = RunWithShiftedMarkers(GrowingShift);
   EXPECT_GE(run.stats.marker_fusion.num_drift_disagreements, 1);
   EXPECT_EQ(run.stats.marker_fusion.num_rejected_poses, 0);
-  EXPECT_EQ(run.stats.num_resets, 0);
+  EXPECT_EQ(run.stats.map_session.num_resets, 0);
   for (int t = 60; t < 140; ++t) {
     ASSERT_TRUE(run.reports[t].cam_from_world) << t;
     EXPECT_FALSE(run.reports[t].marker_pose) << t;

@@ -55,9 +55,9 @@ ScenarioRun RunScenario(const Scenario& scenario) {
   SystemOptions options;
   // The synthetic scene gives few keyframes: without this a lost map would be "young" and
   // simply reset, not closed after new_map_after_lost_s.
-  options.reset_max_keyframes = 0;
-  options.merge_closed_maps = scenario.merge_closed_maps;
-  options.bridge_tracking_gaps = scenario.bridge_tracking_gaps;
+  options.map_session.reset_max_keyframes = 0;
+  options.map_session.merge_closed_maps = scenario.merge_closed_maps;
+  options.map_session.bridge_tracking_gaps = scenario.bridge_tracking_gaps;
   options.blocking = scenario.blocking;
   if (scenario.markers) options.marker_map = SceneMarkers(11, scenario.marker_size);
   System system(camera, options);
@@ -113,7 +113,7 @@ double Sim3AlignedRmse(const std::vector<StampedPose>& trajectory) {
 TEST(SystemRecovery, KeypointsOnlyStartsANewMapAfterALongLoss) {
   const Scenario scenario;  // 2 s blackout once the first map has many keyframes
   const ScenarioRun run = RunScenario(scenario);
-  EXPECT_EQ(run.stats.num_new_maps_after_loss, 1);
+  EXPECT_EQ(run.stats.map_session.num_new_maps_after_loss, 1);
   EXPECT_EQ(run.stats.num_initializations, 2);
   EXPECT_EQ(run.invariants, "");
   // The new map tracks the rest of the route (initialised within half a second).
@@ -137,7 +137,7 @@ TEST(SystemRecovery, FramesLostBeforeANewMapAreTrackedBackFromIt) {
   scenario.blackout_begin = scenario.blackout_end = 0;
   scenario.scene_changes_at = 30;
   const ScenarioRun run = RunScenario(scenario);
-  EXPECT_EQ(run.stats.num_new_maps_after_loss, 1);
+  EXPECT_EQ(run.stats.map_session.num_new_maps_after_loss, 1);
   EXPECT_EQ(run.invariants, "");
   // Lost when they were processed: no pose then.
   int lost = 0;
@@ -160,7 +160,7 @@ TEST(SystemRecovery, NewMapAfterLossIsInitialisedFromMarkersInTheWorld) {
   Scenario scenario;
   scenario.markers = true;
   const ScenarioRun run = RunScenario(scenario);
-  EXPECT_EQ(run.stats.num_new_maps_after_loss, 1);
+  EXPECT_EQ(run.stats.map_session.num_new_maps_after_loss, 1);
   // Both maps start from two marker locations, directly in the world.
   EXPECT_EQ(run.stats.num_marker_initializations, 2);
   std::optional<int> second_init;
@@ -196,8 +196,8 @@ TEST(SystemRecovery, ClosedMapIsMergedIntoTheNextMapInTheWorld) {
   scenario.merge_closed_maps = false;
   const ScenarioRun apart = RunScenario(scenario);
   const double blackout_s = kSceneDt * scenario.blackout_begin;
-  EXPECT_EQ(merged.stats.num_map_merges, 1);
-  EXPECT_EQ(apart.stats.num_map_merges, 0);
+  EXPECT_EQ(merged.stats.map_session.num_map_merges, 1);
+  EXPECT_EQ(apart.stats.map_session.num_map_merges, 0);
   EXPECT_EQ(merged.invariants, "");
   // Apart: the final map starts after the blackout; merged: it holds the first map too.
   EXPECT_EQ(CountBefore(apart.map_keyframe_times, blackout_s), 0);
@@ -235,7 +235,7 @@ double WindowRmse(const std::vector<StampedPose>& trajectory, int begin, int end
 // ties its start too (the bridge) in a pose-graph correction. Here the keypoints alone keep
 // the new map right (the end-of-run adjustment restores it even from a bridge 0.5 m off):
 // the bridge must leave it so. Where it helps (a young map drifting in a low-texture turn):
-// the demo sequence, figures at SystemOptions::bridge_tracking_gaps.
+// the demo sequence, figures at MapSessionOptions::bridge_tracking_gaps.
 TEST(SystemRecovery, MapAfterAGapIsBridgedToTheClosedMap) {
   Scenario scenario;
   scenario.markers = true;
@@ -244,9 +244,9 @@ TEST(SystemRecovery, MapAfterAGapIsBridgedToTheClosedMap) {
   const ScenarioRun bridged = RunScenario(scenario);
   scenario.bridge_tracking_gaps = false;
   const ScenarioRun unbridged = RunScenario(scenario);
-  EXPECT_EQ(bridged.stats.num_map_merges, 1);
-  EXPECT_EQ(bridged.stats.num_bridged_gaps, 1);
-  EXPECT_EQ(unbridged.stats.num_bridged_gaps, 0);
+  EXPECT_EQ(bridged.stats.map_session.num_map_merges, 1);
+  EXPECT_EQ(bridged.stats.map_session.num_bridged_gaps, 1);
+  EXPECT_EQ(unbridged.stats.map_session.num_bridged_gaps, 0);
   EXPECT_EQ(bridged.invariants, "");
   int bridged_count = 0, unbridged_count = 0;
   const double bridged_rmse = WindowRmse(bridged.trajectory, scenario.blackout_end,
@@ -271,7 +271,7 @@ TEST(SystemRecovery, ClosedMapIsMergedWithLocalMappingThreaded) {
   scenario.markers = true;
   scenario.blocking = false;
   const ScenarioRun run = RunScenario(scenario);
-  EXPECT_EQ(run.stats.num_map_merges, 1);
+  EXPECT_EQ(run.stats.map_session.num_map_merges, 1);
   EXPECT_EQ(run.invariants, "");
   EXPECT_GE(CountBefore(run.map_keyframe_times, kSceneDt * scenario.blackout_begin), 3);
   EXPECT_EQ(run.keyframes.size(), run.map_keyframe_times.size());
@@ -283,7 +283,7 @@ TEST(SystemRecovery, MapNeverAlignedStaysOutOfTheWorldTrajectory) {
   scenario.markers = true;
   scenario.markers_until = scenario.blackout_begin;  // no marker after the blackout
   const ScenarioRun run = RunScenario(scenario);
-  EXPECT_EQ(run.stats.num_new_maps_after_loss, 1);
+  EXPECT_EQ(run.stats.map_session.num_new_maps_after_loss, 1);
   EXPECT_EQ(run.stats.num_initializations, 2);  // the second map is built and tracked ...
   EXPECT_FALSE(run.reports.back().world_aligned);
   EXPECT_TRUE(run.reports.back().cam_from_world.has_value());

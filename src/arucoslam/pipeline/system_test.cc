@@ -42,11 +42,12 @@ std::shared_ptr<const Vocabulary> ShippedVocabulary() {
 
 RunResult RunSynthetic(bool blocking, int num_frames, bool moving = true,
                        std::shared_ptr<const Vocabulary> vocabulary = nullptr,
-                       int max_backfill_frames = SystemOptions().max_backfill_frames) {
+                       int max_backfill_frames =
+                           SystemOptions().map_session.max_backfill_frames) {
   SyntheticFeatureScene scene(TestCamera());
   SystemOptions options;
   options.blocking = blocking;
-  options.max_backfill_frames = max_backfill_frames;
+  options.map_session.max_backfill_frames = max_backfill_frames;
   options.vocabulary = std::move(vocabulary);
   System system(TestCamera(), options);
   RunResult run;
@@ -314,7 +315,7 @@ TEST(System, KidnappedCameraIsRelocalisedFromThePlaceDatabase) {
   EXPECT_EQ(first_relocalised, 10);  // the first frame after the kidnapping
   EXPECT_EQ(posed_after, 20);
   EXPECT_GT(stats.places.num_relocalizations, relocalisations_before);
-  EXPECT_EQ(stats.num_resets, 0);
+  EXPECT_EQ(stats.map_session.num_resets, 0);
   // Every pose, before and after, against the truth after one Sim(3) alignment: the
   // relocalised leg is in the same map frame and scale as the first one.
   std::vector<Eigen::Vector3d> estimated, expected;

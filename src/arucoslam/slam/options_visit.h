@@ -13,6 +13,7 @@
 #include "arucoslam/slam/loop_closer.h"
 #include "arucoslam/slam/loop_detector.h"
 #include "arucoslam/slam/map_initialization.h"
+#include "arucoslam/slam/map_session.h"
 #include "arucoslam/slam/marker_fusion.h"
 #include "arucoslam/slam/marker_mapper.h"
 #include "arucoslam/slam/relocalizer.h"
@@ -308,6 +309,35 @@ void VisitOptions(MarkerFusionOptions& o, Visitor& visit) {
         "sooner: drift only when the disagreement grew at most this since the last, metres");
   visit("max_drift_correction_frames", o.max_drift_correction_frames,
         "frames that wait for a drift correction");
+}
+
+template <class Visitor>
+void VisitOptions(MapSessionOptions& o, Visitor& visit) {
+  visit("reset_max_keyframes", o.reset_max_keyframes,
+        "lost with at most this many keyframes, not in the world: discarded, initialised again");
+  visit("marker_reset_lost_frames", o.marker_reset_lost_frames,
+        "aligned map lost this many frames while markers give poses: a new map");
+  visit("new_map_after_lost_s", o.new_map_after_lost_s,
+        "lost this long and not relocalised: a new map, seconds");
+  visit("merge_closed_maps", o.merge_closed_maps,
+        "a closed aligned map is merged into the next map once that one is aligned");
+  visit("bridge_tracking_gaps", o.bridge_tracking_gaps,
+        "a gap between two aligned maps bridged by a constant-velocity prediction");
+  visit("bridge_motion", o.bridge_motion, "that prediction");
+  visit("bridge_position_sigma_m", o.bridge_position_sigma_m,
+        "its position sigma, metres, plus ...");
+  visit("bridge_position_sigma_per_s", o.bridge_position_sigma_per_s,
+        "... this per second of gap, metres per second");
+  visit("bridge_rotation_sigma_rad", o.bridge_rotation_sigma_rad,
+        "its rotation sigma, radians, plus ...");
+  visit("bridge_rotation_sigma_per_s", o.bridge_rotation_sigma_per_s,
+        "... this per second of gap, radians per second");
+  visit("bridge_in_bundle_adjustment", o.bridge_in_bundle_adjustment,
+        "the bridge's camera centre stays a prior in whole-map bundle adjustments");
+  visit("bridge_max_acceleration_m_s2", o.bridge_max_acceleration_m_s2,
+        "its sigma there grows with this x gap^2 / 2, metres per second squared");
+  visit("max_backfill_frames", o.max_backfill_frames,
+        "frames before initialisation tracked backwards against the new map (0: none)");
 }
 
 }  // namespace arucoslam

@@ -1,5 +1,5 @@
-// System's recovery after a long loss (a new map; the old one closed, kept whole for a merge
-// when in the world) and map initialisation from two marker locations, directly in the world.
+// System's map initialisation from two marker locations: the matches triangulated with the
+// markers' relative pose, the map built directly in the marker world.
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -63,55 +63,13 @@ InitializationResult TriangulateWithKnownMotion(const Frame& frame1, const Frame
 
 }  // namespace
 
-bool System::LostTooLong(const Frame& frame) {
-  if (!lost_since_s_) lost_since_s_ = frame.timestamp_s;
-  return frame.timestamp_s - *lost_since_s_ >= options_.new_map_after_lost_s;
-}
-
-bool System::CloseMap() {
-  const std::size_t keyframes = map_->NumKeyframes();
-  if (keyframes == 0) return false;
-  if (!options_.marker_map) {
-    // Keypoints only: maps are in unrelated frames; the biggest one is the output.
-    if (keyframes > biggest_closed_keyframes_) {
-      biggest_closed_poses_ = CurrentMapPoses(/*world_only=*/false);
-      biggest_closed_keyframes_ = keyframes;
-    }
-    return false;
-  }
-  if (!world_aligned_) {
-    // Never aligned: its poses are dropped by ResetMap (not in the world frame).
-    std::lock_guard lock(stats_mutex_);
-    ++stats_.num_maps_discarded;
-    return false;
-  }
-  // Before its poses are frozen: the whole map against every marker it saw.
-  AdjustWholeMapWithMarkers("map closed");
-  RememberMotionAtClose();
-  ClosedMap closed;
-  closed.output_keyframes_before = closed_keyframes_.size();
-  closed.output_points_before = closed_points_.size();
-  closed_keyframes_ = KeyframePoses();
-  closed_points_ = MapPoints();
-  if (!options_.merge_closed_maps) return false;
-  closed.data = map_->Read([](const MapData& data) { return data; });
-  {
-    std::lock_guard lock(keyframe_fixes_mutex_);
-    closed.keyframe_fixes = keyframe_fixes_;
-  }
-  closed_map_ = std::move(closed);  // an older one not merged stays in the outputs only
-  return true;
-}
-
 bool System::InitializeFromMarkers(Frame& frame, FrameReport& report) {
   const std::optional<MarkerFix>& fix = marker_fusion_.fix();
   if (!fix) return false;
   if (!init_reference_fix_) {
     // A reference with a marker location allows the metric initialisation below.
     if (report.num_features >= options_.initializer.min_matches) {
-      KeepForBackfill();
-      init_reference_ = frame;
-      init_reference_fix_ = fix;
+      ReplaceInitReference(frame);
       report.message = "initialisation reference (markers)";
       return true;
     }
