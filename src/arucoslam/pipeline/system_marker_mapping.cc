@@ -31,8 +31,8 @@ void System::StartMarkerMapping() {
     if (places_) places_->SetMarkerLandmarks(marker_mapper_->mutable_landmarks());
   }
   if (places_ && options_.marker_priors_in_loops) {
-    places_->SetLoopPosePriors([this] { return KnownMarkerPriors(); },
-                               options_.marker_correction_graph);
+    places_->SetLoopPosePriors([this] { return anchoring_.KnownMarkerPriors(); },
+                               options_.world_anchoring.marker_correction_graph);
   }
   // Keyframes mapped before the alignment are recorded now, at their aligned poses.
   const std::vector<KeyframeId> keyframes = map_->Read([&](const MapData& data) {

@@ -116,7 +116,7 @@ TEST(SystemMarkers, OptionsCheck) {
   SystemOptions options;
   options.marker_map = SceneMarkers();
   EXPECT_TRUE(options.Check());
-  options.min_alignment_anchors = 1;
+  options.world_anchoring.min_alignment_anchors = 1;
   EXPECT_FALSE(options.Check());
   for (const auto& breaks : std::vector<std::function<void(SystemOptions*)>>{
            [](SystemOptions* o) { o->marker_fusion.min_drift_interval_s = -1.0; },
