@@ -70,10 +70,6 @@ void VisitOptions(SystemOptions& o, Visitor& visit) {
   visit("min_locating_marker_keyframes", o.min_locating_marker_keyframes,
         "mapped markers seen by this many keyframes locate frames (0: never)");
   visit("marker_mapping", o.marker_mapping, "mapping of markers absent from the marker map");
-  visit("marker_drift_correction", o.marker_drift_correction,
-        "pose-graph correction of the aligned map when a keyframe's markers disagree");
-  visit("marker_priors_in_loops", o.marker_priors_in_loops,
-        "loops in the aligned map corrected with the marker priors");
   visit("places", o.places, "place recognition: relocalisation and loops (with a vocabulary)");
   visit("min_marker_init_baseline_m", o.min_marker_init_baseline_m,
         "marker initialisation: two marker locations at least this far apart, metres");

@@ -541,7 +541,9 @@ std::vector<Eigen::Vector3d> System::MapPoints() const {
 
 SystemStats System::Stats() const {
   std::lock_guard lock(stats_mutex_);
-  return stats_;
+  SystemStats stats = stats_;
+  stats.world_anchoring = anchoring_.stats();
+  return stats;
 }
 
 }  // namespace arucoslam

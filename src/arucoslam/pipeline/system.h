@@ -119,14 +119,6 @@ struct SystemOptions {
   // (marker poses and relocalisation where the known map has no marker). 0: never.
   int min_locating_marker_keyframes = 3;
   MarkerMapperOptions marker_mapping;
-  // Drift correction (system_drift_correction.cc): a keyframe of the aligned map whose marker
-  // location disagrees with its keypoint pose (world_anchoring decides) triggers a pose-graph
-  // correction of the whole map with the marker priors.
-  bool marker_drift_correction = true;
-  // A loop closed in the world-aligned map is corrected with the same marker priors and
-  // graph weights (world_anchoring.marker_correction_graph), no keyframe held fixed: the loop
-  // then keeps the world anchoring.
-  bool marker_priors_in_loops = true;
 
   // Bag-of-words vocabulary. When set, keyframes enter a place database: lost tracking is
   // relocalised from it and, with places.loop_closing, loops are closed. Null: neither.
@@ -204,13 +196,12 @@ struct SystemStats {
   int num_relocated_marker_poses = 0;  // marker poses located again in the final marker map
   int num_late_marker_poses = 0;       // frames without a pose located in it at the end
   int num_marker_only_poses = 0;  // frames whose pose came from markers alone
-  int num_world_alignments = 0;
+  WorldAnchoringStats world_anchoring;  // alignments to the marker world, drift corrections
   int num_marker_relocalizations = 0;  // tracking restarted from a marker pose
   int num_map_relocalizations = 0;     // loaded map: restarted from a keyframe match
   PlaceRecognitionStats places;        // relocalisation and loops (with a vocabulary)
   int num_marker_initializations = 0;  // maps initialised from two marker locations
   MapSessionStats map_session;         // resets, closed maps, merges and bridged gaps
-  int num_marker_corrections = 0;      // pose-graph corrections of drift by markers
   int num_whole_map_marker_adjustments = 0;  // bundle adjustments of a whole map with markers
   int num_refined_frame_poses = 0;  // frames re-optimised against the final map at Finish
   int num_yielded_bundle_adjustments = 0;  // local BAs ended early for a waiting keyframe

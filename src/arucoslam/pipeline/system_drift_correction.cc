@@ -12,7 +12,7 @@
 namespace arucoslam {
 
 bool System::CorrectDriftWithMarkers(KeyframeId keyframe) {
-  if (!options_.marker_drift_correction || !marker_mapping_live_) return false;
+  if (!marker_mapping_live_) return false;
   const std::optional<DriftCorrectionDecision> decision =
       anchoring_.DecideDriftCorrection(*map_, keyframe);
   if (!decision) return false;
@@ -27,8 +27,7 @@ bool System::CorrectDriftWithMarkers(KeyframeId keyframe) {
   if (!result.applied) return false;
   if (places_) places_->RecordScaleChanges(result.scale_changes);
   ++marker_corrections_;
-  std::lock_guard lock(stats_mutex_);
-  ++stats_.num_marker_corrections;
+  anchoring_.DriftCorrected();
   return true;
 }
 

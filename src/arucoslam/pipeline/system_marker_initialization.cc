@@ -126,7 +126,6 @@ bool System::InitializeFromMarkers(Frame& frame, FrameReport& report) {
   {
     std::lock_guard lock(stats_mutex_);
     ++stats_.num_marker_initializations;
-    ++stats_.num_world_alignments;
   }
   ARUCOSLAM_LOG_DEBUG("frame {}: map initialised from markers in the world, baseline {:.2f} m, "
                       "scale {:.3f}", report.index, baseline, world_from_map.scale);

@@ -30,7 +30,7 @@ void System::StartMarkerMapping() {
     // The caller holds the places' edit lock (LockPlacesForMapMove).
     if (places_) places_->SetMarkerLandmarks(marker_mapper_->mutable_landmarks());
   }
-  if (places_ && options_.marker_priors_in_loops) {
+  if (places_ && options_.world_anchoring.priors_in_loops) {
     places_->SetLoopPosePriors([this] { return anchoring_.KnownMarkerPriors(); },
                                options_.world_anchoring.marker_correction_graph);
   }

@@ -113,8 +113,6 @@ void System::MaybeAlignWorld(Frame& frame) {
   marker_fusion_.MapEnteredWorld(frame.timestamp_s);  // the anchors agree with the map
   keep_marker_keyframes_ = false;
   RefreshKeyframePoseCache();
-  std::lock_guard lock(stats_mutex_);
-  ++stats_.num_world_alignments;
 }
 
 void System::RecordMarkerPose(const Frame& frame, FrameReport& report) {

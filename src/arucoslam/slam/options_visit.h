@@ -325,6 +325,8 @@ void VisitOptions(WorldAnchoringOptions& o, Visitor& visit) {
         "a first alignment with a larger scale is refused (collapsed map)");
   visit("max_realignment_anchors", o.max_realignment_anchors,
         "realigned each time the anchors double, up to this many");
+  visit("drift_correction", o.drift_correction,
+        "pose-graph correction of the aligned map when a keyframe's markers disagree");
   visit("min_marker_correction_m", o.min_marker_correction_m,
         "a drift correction needs a disagreement beyond this, metres ...");
   visit("marker_correction_sigmas", o.marker_correction_sigmas,
@@ -332,6 +334,8 @@ void VisitOptions(WorldAnchoringOptions& o, Visitor& visit) {
   visit("marker_priors", o.marker_priors, "keyframe marker locations as priors");
   visit("marker_correction_graph", o.marker_correction_graph,
         "the pose graph of marker corrections");
+  visit("priors_in_loops", o.priors_in_loops,
+        "loops in the aligned map corrected with the marker priors");
 }
 
 template <class Visitor>

@@ -104,11 +104,20 @@ void WorldAnchoring::DropOutlierFixes(const AlignmentDecision& decision) {
 void WorldAnchoring::AlignmentApplied(const AlignmentDecision& decision) {
   next_alignment_anchors_ = 2 * static_cast<int>(decision.anchors.size());
   aligned_ = true;
+  ++num_alignments_;
 }
 
 void WorldAnchoring::AlignedFromMarkers() {
   aligned_ = true;
   next_alignment_anchors_ = options_.min_alignment_anchors;
+  ++num_alignments_;
+}
+
+WorldAnchoringStats WorldAnchoring::stats() const {
+  WorldAnchoringStats stats;
+  stats.num_alignments = num_alignments_;
+  stats.num_drift_corrections = num_drift_corrections_;
+  return stats;
 }
 
 void WorldAnchoring::StopRealigning() {

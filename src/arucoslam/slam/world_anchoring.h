@@ -2,6 +2,7 @@
 // when the map is aligned (and realigned) to them, and when they correct its drift.
 #pragma once
 
+#include <atomic>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -38,6 +39,8 @@ struct WorldAnchoringOptions {
   // farther than min_marker_correction_m (metres) and than marker_correction_sigmas of that
   // pose's standard deviation from its keypoint pose triggers a pose-graph correction of the
   // whole map, with the marker pose of every keyframe that sees known markers as a prior.
+  // false: never.
+  bool drift_correction = true;
   double min_marker_correction_m = 0.05;
   double marker_correction_sigmas = 3.0;
   // A keyframe's marker location as a prior: 1 cm and 0.01 rad per marker (divided by
@@ -63,7 +66,17 @@ struct WorldAnchoringOptions {
     return graph;
   }();
 
+  // A loop closed in the world-aligned map is corrected with the same marker priors and
+  // graph weights (marker_correction_graph), no keyframe held fixed: the loop then keeps the
+  // world anchoring.
+  bool priors_in_loops = true;
+
   bool Check(std::string* why = nullptr) const;
+};
+
+struct WorldAnchoringStats {
+  int num_alignments = 0;         // the map aligned (or realigned) to the marker world
+  int num_drift_corrections = 0;  // pose-graph corrections of drift by markers
 };
 
 // An accepted alignment of the map to the marker world, and the anchors it was fitted to
@@ -88,6 +101,7 @@ class WorldAnchoring {
 
   const WorldAnchoringOptions& options() const { return options_; }
   bool aligned() const { return aligned_; }
+  WorldAnchoringStats stats() const;
 
   // A new keyframe with its marker location (none: nothing to remember).
   void AddAnchor(KeyframeId keyframe, const std::optional<MarkerFix>& fix);
@@ -122,6 +136,8 @@ class WorldAnchoring {
   // for a pose-graph correction.
   std::optional<DriftCorrectionDecision> DecideDriftCorrection(const Map& map,
                                                                KeyframeId keyframe) const;
+  // Mapping thread: the correction DecideDriftCorrection asked for moved the map.
+  void DriftCorrected() { ++num_drift_corrections_; }
 
  private:
   struct MarkerAnchor {
@@ -137,6 +153,8 @@ class WorldAnchoring {
   // mapping thread reads for drift correction).
   mutable std::mutex fixes_mutex_;
   std::map<KeyframeId, MarkerFix> keyframe_fixes_;
+  std::atomic<int> num_alignments_{0};
+  std::atomic<int> num_drift_corrections_{0};  // counted by the mapping thread
 };
 
 }  // namespace arucoslam

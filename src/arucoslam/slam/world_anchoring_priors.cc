@@ -27,6 +27,7 @@ std::vector<KeyframePosePrior> WorldAnchoring::KnownMarkerPriors() const {
 
 std::optional<DriftCorrectionDecision> WorldAnchoring::DecideDriftCorrection(
     const Map& map, KeyframeId keyframe) const {
+  if (!options_.drift_correction) return std::nullopt;
   std::optional<KeyframePosePrior> own;
   {
     std::lock_guard lock(fixes_mutex_);

@@ -87,6 +87,8 @@ TEST(WorldAnchoring, RealignsWhenTheAnchorsDouble) {
   const std::optional<AlignmentDecision> again = anchoring.DecideAlignment(map);
   ASSERT_TRUE(again.has_value());
   EXPECT_EQ(again->anchors.size(), 8u);
+  anchoring.AlignmentApplied(*again);
+  EXPECT_EQ(anchoring.stats().num_alignments, 2);
   // No more anchors are collected once realignment stopped.
   anchoring.StopRealigning();
   AddAnchors(8, 20, &map, &anchoring);
@@ -151,6 +153,16 @@ TEST(WorldAnchoring, DriftIsCorrectedBeyondFiveCentimetresAndThreeSigmas) {
   EXPECT_NEAR(1.0 / std::sqrt(loose_anchoring.KnownMarkerPriors()[0].information(0, 0)), 0.1,
               1e-12);
   EXPECT_FALSE(loose_anchoring.DecideDriftCorrection(map, far).has_value());
+  // Switched off: no correction, however far.
+  WorldAnchoringOptions off;
+  off.drift_correction = false;
+  WorldAnchoring off_anchoring(off);
+  off_anchoring.AddKeyframeFixes(anchoring.KeyframeFixes());
+  EXPECT_FALSE(off_anchoring.DecideDriftCorrection(map, far).has_value());
+  // The corrections made are counted, with the alignments.
+  anchoring.DriftCorrected();
+  EXPECT_EQ(anchoring.stats().num_drift_corrections, 1);
+  EXPECT_EQ(anchoring.stats().num_alignments, 1);
 }
 
 TEST(WorldAnchoring, MappedMarkersAndOutliersGiveNoPrior) {
