@@ -412,9 +412,7 @@ class System {
   std::optional<MarkerFix> init_reference_fix_;
   // The anchors, alignment decisions and marker priors of the current map.
   WorldAnchoring anchoring_;
-  // Until the map is aligned, keyframes that saw a marker are not culled: they carry the
-  // alignment's anchors (read by the mapping thread's keyframe culling).
-  std::atomic<bool> keep_marker_keyframes_{true};
+  // With a marker map: keyframes anchoring_ keeps are not culled.
   void GuardMarkerKeyframes();
   // A new mapper_ for map_: marker-keyframe guard, and in threaded mode the BA's yield to a
   // waiting keyframe (yield_bundle_adjustment).

@@ -33,7 +33,6 @@ void System::StartFromMap(MapData map, bool world_aligned, bool localize_only) {
   map_loaded_ = true;
   localize_only_ = localize_only;
   anchoring_.StartLoadedMap(world_aligned);
-  keep_marker_keyframes_ = !world_aligned;
   if (places_) {
     places_->SetMetricMap(world_aligned);
     places_->IndexExistingKeyframes();

@@ -121,7 +121,6 @@ bool System::InitializeFromMarkers(Frame& frame, FrameReport& report) {
   frame.cam_from_world = to_world(*frame.cam_from_world);
   anchoring_.AlignedFromMarkers();  // re-aligned as anchors come
   marker_fusion_.MapEnteredWorld(frame.timestamp_s);
-  keep_marker_keyframes_ = false;
   RefreshKeyframePoseCache();
   {
     std::lock_guard lock(stats_mutex_);

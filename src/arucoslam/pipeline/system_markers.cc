@@ -38,10 +38,8 @@ void System::LocateWithMarkers(Frame& frame, const std::vector<MarkerDetection>&
 
 void System::GuardMarkerKeyframes() {
   if (!options_.marker_map) return;
-  keep_marker_keyframes_ = true;
-  mapper_->SetKeyframeGuard([this](const Keyframe& keyframe) {
-    return keep_marker_keyframes_ && !keyframe.markers.empty();
-  });
+  mapper_->SetKeyframeGuard(
+      [this](const Keyframe& keyframe) { return anchoring_.KeepsKeyframe(keyframe); });
 }
 
 bool System::RelocalizeWithMarkers(Frame& frame, FrameReport& report) {
@@ -111,7 +109,6 @@ void System::MaybeAlignWorld(Frame& frame) {
                       alignment.num_inliers, anchors.size(), alignment.rms_m);
   anchoring_.AlignmentApplied(*decision);
   marker_fusion_.MapEnteredWorld(frame.timestamp_s);  // the anchors agree with the map
-  keep_marker_keyframes_ = false;
   RefreshKeyframePoseCache();
 }
 

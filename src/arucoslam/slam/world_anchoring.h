@@ -102,6 +102,11 @@ class WorldAnchoring {
   const WorldAnchoringOptions& options() const { return options_; }
   bool aligned() const { return aligned_; }
   WorldAnchoringStats stats() const;
+  // Mapping thread (keyframe culling): until the map is aligned, a keyframe that saw a marker
+  // is kept, as it may carry an anchor.
+  bool KeepsKeyframe(const Keyframe& keyframe) const {
+    return !aligned_ && !keyframe.markers.empty();
+  }
 
   // A new keyframe with its marker location (none: nothing to remember).
   void AddAnchor(KeyframeId keyframe, const std::optional<MarkerFix>& fix);
@@ -146,7 +151,7 @@ class WorldAnchoring {
   };
 
   WorldAnchoringOptions options_;
-  bool aligned_ = false;
+  std::atomic<bool> aligned_{false};  // also read by the mapping thread (KeepsKeyframe)
   std::vector<MarkerAnchor> anchors_;
   int next_alignment_anchors_ = 0;  // alignment is tried again at this many anchors
   // The marker location of every keyframe inserted with one (the tracking thread writes, the

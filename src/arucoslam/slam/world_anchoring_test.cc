@@ -61,8 +61,13 @@ TEST(WorldAnchoring, AlignsWithFourAnchorsSpanningHalfAMetreNotThree) {
   EXPECT_NEAR(decision->alignment.world_from_map.scale, 2.0, 1e-6);
   EXPECT_LT(decision->alignment.rms_m, 1e-6);
   EXPECT_FALSE(anchoring.aligned());
+  Keyframe with_marker;
+  with_marker.markers.resize(1);
+  EXPECT_TRUE(anchoring.KeepsKeyframe(with_marker));
+  EXPECT_FALSE(anchoring.KeepsKeyframe(Keyframe()));
   anchoring.AlignmentApplied(*decision);
   EXPECT_TRUE(anchoring.aligned());
+  EXPECT_FALSE(anchoring.KeepsKeyframe(with_marker));
 }
 
 TEST(WorldAnchoring, ShortBaselineWaits) {
