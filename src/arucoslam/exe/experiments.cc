@@ -134,7 +134,7 @@ ExperimentRun MarkerSlamRun(const fs::path& sequence, const fs::path& out_dir,
       "after a loss ({} never aligned, left out), {} keyframes, {} map points in the last map{}",
       result.stats.frames_tracked, result.stats.frames, result.timing.num_marker_only_poses,
       result.timing.num_unposed_without_markers, result.stats.losses, result.timing.num_marker_relocalizations,
-      result.timing.num_world_alignments, result.timing.num_marker_initializations,
+      result.timing.world_anchoring.num_alignments, result.timing.num_marker_initializations,
       result.timing.map_session.num_new_maps_after_loss,
       result.timing.map_session.num_maps_discarded, result.stats.keyframes, result.stats.map_points,
       options.marker_mapping.ground_plane_prior

@@ -249,7 +249,7 @@ TEST_F(PlacesEndToEnd, ALoopClosedInTheMarkerWorldStaysInTheWorld) {
   const RunOutcome closed = run(true);
   std::printf("world-frame ATE open %.3f m, closed %.3f m; %zu loops closed\n", open.ate_m,
               closed.ate_m, closed.stats.places.loops.size());
-  EXPECT_GE(closed.stats.num_world_alignments, 1);
+  EXPECT_GE(closed.stats.world_anchoring.num_alignments, 1);
   ASSERT_GE(closed.stats.places.loops.size(), 1u);
   EXPECT_EQ(CountFalseLoops(dataset, closed), 0);
   EXPECT_GE(closed.trajectory.size(), 0.95 * dataset.size());

@@ -57,8 +57,8 @@ SlamRunStats MakeStats(const std::string& dataset_label, const FrameSource& sour
   out.relocated_marker_poses = stats.num_relocated_marker_poses;
   out.late_marker_poses = stats.num_late_marker_poses;
   out.marker_only_poses = stats.num_marker_only_poses;
-  out.world_alignments = stats.num_world_alignments;
-  out.marker_drift_corrections = stats.num_marker_corrections;
+  out.world_alignments = stats.world_anchoring.num_alignments;
+  out.marker_drift_corrections = stats.world_anchoring.num_drift_corrections;
   out.marker_rejections = stats.marker_fusion.num_rejected_poses;
   out.drift_beyond_gate = stats.marker_fusion.num_drift_disagreements;
   out.whole_map_marker_adjustments = stats.num_whole_map_marker_adjustments;

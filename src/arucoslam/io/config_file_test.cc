@@ -103,7 +103,9 @@ TEST(ConfigFileTest, OneKeyChangesOneOption) {
   EXPECT_EQ(over.extractor.min_fast_threshold, 5);
   EXPECT_FALSE(over.blocking);
   // Integers are numbers too; an empty file changes nothing.
-  EXPECT_EQ(Parse("max_alignment_scale: 80\n").max_alignment_scale, 80.0);
+  EXPECT_EQ(
+      Parse("world_anchoring: {max_alignment_scale: 80}\n").world_anchoring.max_alignment_scale,
+      80.0);
   EXPECT_EQ(SystemOptionsYaml(Parse("# nothing\n", start)), SystemOptionsYaml(start));
 }
 
@@ -129,8 +131,8 @@ TEST(ConfigFileTest, BadFilesNameTheKeyAndLine) {
        "test.yaml: extractor.num_features (line 2): expected an integer, found 'many'"},
       {"blocking: 1\n", "blocking (line 1): expected true or false, found '1'"},
       {"initializer: {seed: -1}\n", "initializer.seed (line 1): expected an integer from 0 to"},
-      {"alignment:\n  outlier_threshold_m: nan\n",
-       "alignment.outlier_threshold_m (line 2): expected a number, found 'nan'"},
+      {"world_anchoring:\n  alignment:\n    outlier_threshold_m: nan\n",
+       "world_anchoring.alignment.outlier_threshold_m (line 3): expected a number, found 'nan'"},
       {"detector:\n  corner_refinement: fancy\n",
        "detector.corner_refinement (line 2): expected one of none, subpix, contour, apriltag"},
       {"extractor: 3\n", "extractor (line 1): expected a section"},
@@ -145,10 +147,11 @@ TEST(ConfigFileTest, BadFilesNameTheKeyAndLine) {
        "mapper.bundle_adjustment.solver.max_iterations (line 4): -2 is out of range or "
        "inconsistent with the other mapper.bundle_adjustment.solver options: "
        "mapper.bundle_adjustment.solver.max_iterations must be >= 1, is -2"},
-      {"min_alignment_anchors: 8\nmax_realignment_anchors: 6\n",
-       "test.yaml: these values fail the top-level options' check together: "
-       "min_alignment_anchors: 8 (line 1), max_realignment_anchors: 6 (line 2); "
-       "max_realignment_anchors must be >= min_alignment_anchors (8), is 6"},
+      {"world_anchoring:\n  min_alignment_anchors: 8\n  max_realignment_anchors: 6\n",
+       "test.yaml: world_anchoring (line 2): these values fail the world_anchoring options' "
+       "check together: world_anchoring.min_alignment_anchors: 8 (line 2), "
+       "world_anchoring.max_realignment_anchors: 6 (line 3); "
+       "world_anchoring.max_realignment_anchors must be >= min_alignment_anchors (8), is 6"},
   };
   for (const auto& [text, expected] : cases) {
     const std::string message = ParseError(text);

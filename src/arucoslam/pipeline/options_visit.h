@@ -56,19 +56,10 @@ void VisitOptions(SystemOptions& o, Visitor& visit) {
   visit("marker_search", o.marker_search, "where each image's markers are searched");
   visit("marker_fusion", o.marker_fusion,
         "each frame's marker location and the verdict on keypoint poses against it");
-  visit("alignment", o.alignment, "keypoint map to marker world alignment (Sim3)");
   visit("relocate_marker_poses", o.relocate_marker_poses,
         "at the end, with mapped markers: frames located again in the final marker map");
-  visit("min_alignment_anchors", o.min_alignment_anchors,
-        "world alignment waits for this many keyframes with a marker location");
-  visit("min_alignment_baseline_m", o.min_alignment_baseline_m,
-        "... whose camera centres span at least this, metres");
-  visit("max_alignment_rms_m", o.max_alignment_rms_m,
-        "alignment refused above this anchor residual, metres");
-  visit("max_alignment_scale", o.max_alignment_scale,
-        "a first alignment with a larger scale is refused (collapsed map)");
-  visit("max_realignment_anchors", o.max_realignment_anchors,
-        "realigned each time the anchors double, up to this many");
+  visit("world_anchoring", o.world_anchoring,
+        "keyframes' marker locations: alignment of the map to the marker world, drift priors");
   visit("min_frames_between_anchor_keyframes", o.min_frames_between_anchor_keyframes,
         "before alignment a frame with a marker location becomes a keyframe after this many");
   visit("markers_in_local_ba", o.markers_in_local_ba,
@@ -79,17 +70,6 @@ void VisitOptions(SystemOptions& o, Visitor& visit) {
   visit("min_locating_marker_keyframes", o.min_locating_marker_keyframes,
         "mapped markers seen by this many keyframes locate frames (0: never)");
   visit("marker_mapping", o.marker_mapping, "mapping of markers absent from the marker map");
-  visit("marker_drift_correction", o.marker_drift_correction,
-        "pose-graph correction of the aligned map when a keyframe's markers disagree");
-  visit("marker_priors_in_loops", o.marker_priors_in_loops,
-        "loops in the aligned map corrected with the marker priors");
-  visit("min_marker_correction_m", o.min_marker_correction_m,
-        "a correction needs a disagreement beyond this, metres ...");
-  visit("marker_correction_sigmas", o.marker_correction_sigmas,
-        "... and beyond this many standard deviations of the marker pose");
-  visit("marker_priors", o.marker_priors, "keyframe marker locations as priors");
-  visit("marker_correction_graph", o.marker_correction_graph,
-        "the pose graph of marker corrections");
   visit("places", o.places, "place recognition: relocalisation and loops (with a vocabulary)");
   visit("min_marker_init_baseline_m", o.min_marker_init_baseline_m,
         "marker initialisation: two marker locations at least this far apart, metres");

@@ -43,13 +43,7 @@ bool SystemOptions::Check(std::string* why) const {
   check.AtLeast("synchronous_young_map_keyframes", synchronous_young_map_keyframes, 0);
   check.Nested("detector", detector);
   check.Nested("marker_fusion", marker_fusion);
-  check.Nested("alignment", alignment);
-  check.AtLeast("min_alignment_anchors", min_alignment_anchors, 2);
-  check.AtLeast("min_alignment_baseline_m", min_alignment_baseline_m, 0.0);
-  check.Above("max_alignment_rms_m", max_alignment_rms_m, 0.0);
-  check.Above("max_alignment_scale", max_alignment_scale, 0.0);
-  check.AtLeast("max_realignment_anchors", max_realignment_anchors, min_alignment_anchors,
-                "min_alignment_anchors");
+  check.Nested("world_anchoring", world_anchoring);
   check.Nested("places", places);
   check.AtLeast("min_frames_between_anchor_keyframes", min_frames_between_anchor_keyframes, 0);
   check.Nested("marker_mapping", marker_mapping);
@@ -67,6 +61,7 @@ System::System(const CameraModel& camera, const SystemOptions& options)
       extractor_(options.extractor),
       initializer_(options.initializer),
       marker_fusion_(MakeMarkerFusion(options, camera)),
+      anchoring_(options.world_anchoring),
       map_session_(options.map_session, options.marker_map.has_value()) {
   if (std::string why; !options_.Check(&why)) {
     throw std::invalid_argument("System: invalid SystemOptions: " + why);
@@ -240,18 +235,18 @@ FrameReport System::ProcessFrame(Frame frame, const std::vector<MarkerDetection>
     Track(frame, report);
   }
   // A loaded map that stays outside the marker world takes no marker-only poses.
-  const bool marker_poses = world_aligned_ || !localize_only_;
+  const bool marker_poses = anchoring_.aligned() || !localize_only_;
   if (!report.cam_from_world && fix && marker_poses) RecordMarkerPose(frame, report);
   if (!localize_only_) FeedMarkerView(frame);
   // Without a world pose now (none, or a keypoint pose outside the world without a marker
   // location), a frame that saw markers may be located at the end.
-  const bool world_pose = report.cam_from_world && (world_aligned_ || fix);
+  const bool world_pose = report.cam_from_world && (anchoring_.aligned() || fix);
   if (!world_pose && !frame.markers.empty()) {
     unposed_marker_frames_.push_back({frame.timestamp_s, frame.markers});
   }
-  report.world_aligned = world_aligned_;
+  report.world_aligned = anchoring_.aligned();
   if (fix) report.marker_world_from_cam = fix->world_from_cam;
-  const bool in_world = !options_.marker_map || world_aligned_ || report.marker_pose;
+  const bool in_world = !options_.marker_map || anchoring_.aligned() || report.marker_pose;
   if (report.cam_from_world && in_world) {
     report.online_world_from_cam = report.cam_from_world->Inverse();
   }
@@ -332,9 +327,9 @@ void System::FinishInitialization(Frame& first, Frame& frame, KeyframeId first_i
     places_->KeyframeMapped(first_id);
     places_->KeyframeMapped(second_id);
   }
-  map_session_.AddBridgePrior(first_id, first.timestamp_s, world_aligned_);
-  AddAnchor(first_id, init_reference_fix_);
-  AddAnchor(second_id, marker_fusion_.fix());
+  map_session_.AddBridgePrior(first_id, first.timestamp_s, anchoring_.aligned());
+  anchoring_.AddAnchor(first_id, init_reference_fix_);
+  anchoring_.AddAnchor(second_id, marker_fusion_.fix());
   init_reference_fix_.reset();
   MaybeAlignWorld(frame);
   frames_since_keyframe_ = 0;
@@ -354,9 +349,10 @@ void System::Track(Frame& frame, FrameReport& report) {
   static const std::vector<MarkerPoseObservation> kNoMarkers;
   FollowMapCorrections();
   const std::optional<MarkerFix>& fix = marker_fusion_.fix();
-  TrackingResult result = tracker_->Track(frame, world_aligned_ && fix ? fix->markers : kNoMarkers);
+  TrackingResult result =
+      tracker_->Track(frame, anchoring_.aligned() && fix ? fix->markers : kNoMarkers);
   if (result.state == TrackingState::kTracking && frame.cam_from_world &&
-      marker_fusion_.JudgeTrackedPose(frame, world_aligned_, report.index) ==
+      marker_fusion_.JudgeTrackedPose(frame, anchoring_.aligned(), report.index) ==
           PoseVerdict::kRejected) {
     tracker_->MarkLost();
     frame.cam_from_world.reset();
@@ -386,7 +382,7 @@ void System::Track(Frame& frame, FrameReport& report) {
   }
   last_state_ = TrackingState::kTracking;
   map_session_.OnTrackedFrame();
-  marker_fusion_.NoteTrackedFrame(frame, relocalized, world_aligned_);
+  marker_fusion_.NoteTrackedFrame(frame, relocalized, anchoring_.aligned());
   ++frames_since_keyframe_;
   MaybeInsertKeyframe(frame, result.num_inliers, report);
   report.cam_from_world = frame.cam_from_world;
@@ -408,7 +404,7 @@ void System::MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& rep
   // A frame with a usable marker location becomes a keyframe sooner until the map is first
   // aligned (anchors are kept on keyframes only).
   const bool wants_anchor =
-      marker_fusion_.fix() && !world_aligned_ &&
+      marker_fusion_.fix() && !anchoring_.aligned() &&
       frames_since_keyframe_ >= options_.min_frames_between_anchor_keyframes &&
       num_inliers > options_.keyframes.min_tracked_points && input.mapper_has_room;
   const bool wants_drift_keyframe = marker_fusion_.drift_keyframe_wanted() && input.mapper_has_room;
@@ -426,7 +422,7 @@ void System::MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& rep
   }
   // The marker location is stored before the keyframe is queued: the mapping thread's drift
   // correction reads it.
-  AddAnchor(keyframe, marker_fusion_.fix());
+  anchoring_.AddAnchor(keyframe, marker_fusion_.fix());
   if (options_.blocking) {
     pending_keyframe_ = keyframe;  // mapped once the frame's tracking time is recorded
   } else {
@@ -436,7 +432,7 @@ void System::MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& rep
       const bool young =
           static_cast<int>(map_->NumKeyframes()) <= options_.synchronous_young_map_keyframes;
       const bool unaligned =
-          options_.marker_map && !world_aligned_ && options_.synchronous_until_aligned;
+          options_.marker_map && !anchoring_.aligned() && options_.synchronous_until_aligned;
       if (young || unaligned) {
         WaitForMapping();
       }
@@ -454,9 +450,9 @@ System::TrackedPose System::MakeTrackedPose(const Frame& frame, KeyframeId refer
   pose.timestamp_s = frame.timestamp_s;
   pose.reference = reference;
   pose.cam_from_world = *frame.cam_from_world;
-  pose.in_world = world_aligned_;
+  pose.in_world = anchoring_.aligned();
   const std::optional<MarkerFix>& fix = marker_fusion_.fix();
-  if (!world_aligned_ && fix) {
+  if (!anchoring_.aligned() && fix) {
     pose.marker_cam_from_world = fix->world_from_cam.Inverse();
     pose.seen_markers = frame.markers;
   }
@@ -477,7 +473,7 @@ System::TrackedPose System::MakeTrackedPose(const Frame& frame, KeyframeId refer
       pose.matches.push_back({frame.map_point_ids[i], frame.UndistortedPixel(index).cast<float>(),
                               static_cast<float>(frame.SigmaPx(index))});
     }
-    if (world_aligned_ && fix && fix->known_markers_only) pose.markers = fix->markers;
+    if (anchoring_.aligned() && fix && fix->known_markers_only) pose.markers = fix->markers;
   }
   return pose;
 }
@@ -518,7 +514,7 @@ std::vector<StampedPose> System::CurrentMapPoses(bool world_only) const {
 
 std::vector<StampedPose> System::KeyframePoses() const {
   std::vector<StampedPose> poses = map_session_.closed_keyframes();
-  if (!options_.marker_map || world_aligned_) {  // else the map is not in the world frame
+  if (!options_.marker_map || anchoring_.aligned()) {  // else the map is not in the world frame
     map_->Read([&](const MapData& data) {
       for (const auto& [id, keyframe] : data.keyframes()) {
         poses.push_back({keyframe.timestamp_s, keyframe.cam_from_world.Inverse()});
@@ -535,7 +531,7 @@ std::vector<StampedPose> System::KeyframePoses() const {
 
 std::vector<Eigen::Vector3d> System::MapPoints() const {
   std::vector<Eigen::Vector3d> points = map_session_.closed_points();
-  if (options_.marker_map && !world_aligned_) return points;  // not in the world frame
+  if (options_.marker_map && !anchoring_.aligned()) return points;  // not in the world frame
   map_->Read([&](const MapData& data) {
     for (const auto& [id, point] : data.map_points()) points.push_back(point.p_in_world);
     return 0;
@@ -545,7 +541,9 @@ std::vector<Eigen::Vector3d> System::MapPoints() const {
 
 SystemStats System::Stats() const {
   std::lock_guard lock(stats_mutex_);
-  return stats_;
+  SystemStats stats = stats_;
+  stats.world_anchoring = anchoring_.stats();
+  return stats;
 }
 
 }  // namespace arucoslam

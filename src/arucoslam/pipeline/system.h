@@ -36,7 +36,7 @@
 #include "arucoslam/slam/marker_fusion.h"
 #include "arucoslam/slam/marker_mapper.h"
 #include "arucoslam/slam/tracker.h"
-#include "arucoslam/slam/world_alignment.h"
+#include "arucoslam/slam/world_anchoring.h"
 #include "arucoslam/util/timing.h"
 
 namespace arucoslam {
@@ -96,25 +96,12 @@ struct SystemOptions {
   // Each frame's marker location, its ambiguity, and the verdict on keypoint poses that
   // contradict it (drift to correct, or a look-alike place).
   MarkerFusionOptions marker_fusion;
-  // Anchor outliers beyond 0.25 m: a single marker's pose at a few metres can be off by more
-  // than WorldAlignmentOptions' 0.10 m default allows.
-  WorldAlignmentOptions alignment{0.0, 0.25, 0.05};
   // At Finish, when markers were mapped: frames posed by markers are located again in the
   // final marker map, and frames that saw markers but got no pose are located in it.
   bool relocate_marker_poses = true;
-  // World alignment waits for this many keyframes with a usable marker location whose
-  // camera centres span at least min_alignment_baseline_m (metres); it is refused when the
-  // anchors' residual after alignment exceeds max_alignment_rms_m (metres).
-  int min_alignment_anchors = 4;
-  double min_alignment_baseline_m = 0.5;
-  double max_alignment_rms_m = 0.15;
-  // A map starts with its median point depth 1: aligning it multiplies lengths by about the
-  // scene's depth in metres. A first alignment's scale above this means the map collapsed
-  // in scale before it saw markers; it is refused.
-  double max_alignment_scale = 100.0;
-  // After the first alignment, anchors keep being collected and the map is aligned again
-  // (a small Sim3 correction) each time their number doubles, up to this many anchors.
-  int max_realignment_anchors = 64;
+  // The keyframes' marker locations: when the map is aligned (and realigned) to the marker
+  // world, and when they correct its drift.
+  WorldAnchoringOptions world_anchoring;
   // Until the first alignment, a frame with a usable marker location becomes a keyframe when
   // at least this many frames passed since the last keyframe.
   int min_frames_between_anchor_keyframes = 1;
@@ -132,39 +119,6 @@ struct SystemOptions {
   // (marker poses and relocalisation where the known map has no marker). 0: never.
   int min_locating_marker_keyframes = 3;
   MarkerMapperOptions marker_mapping;
-  // Drift correction (system_drift_correction.cc): a keyframe of the aligned map whose pose
-  // from its known markers lies farther than min_marker_correction_m and than
-  // marker_correction_sigmas of that pose's standard deviation from its keypoint pose
-  // triggers a pose-graph correction of the whole map, with the marker pose of every
-  // keyframe that sees known markers as a prior.
-  bool marker_drift_correction = true;
-  // A loop closed in the world-aligned map is corrected with the same marker priors and
-  // graph weights (marker_correction_graph), no keyframe held fixed: the loop then keeps the
-  // world anchoring.
-  bool marker_priors_in_loops = true;
-  double min_marker_correction_m = 0.05;
-  double marker_correction_sigmas = 3.0;
-  // A keyframe's marker location as a prior: 1 cm and 0.01 rad per marker (divided by
-  // sqrt(markers)) at 10 marker sides and nearer, growing with distance^2 beyond.
-  MarkerFactorOptions marker_priors = [] {
-    MarkerFactorOptions priors;
-    priors.prior_position_sigma_m = 0.01;
-    priors.prior_rotation_sigma_rad = 0.01;
-    priors.prior_reference_distance_sides = 10.0;
-    return priors;
-  }();
-  // Relative poses between keyframes: 2 cm, 0.005 rad and 1% scale per edge.
-  EssentialGraphOptions marker_correction_graph = [] {
-    EssentialGraphOptions graph;
-    graph.edge_translation_sigma = 0.02;
-    graph.edge_rotation_sigma = 0.005;
-    graph.edge_scale_sigma = 0.01;
-    // A drift of metres (a map whose scale collapsed out of the markers' sight) needs more
-    // than the solver's default 20 iterations; unconverged, the graph leaves the points torn
-    // apart.
-    graph.solver.max_iterations = 100;
-    return graph;
-  }();
 
   // Bag-of-words vocabulary. When set, keyframes enter a place database: lost tracking is
   // relocalised from it and, with places.loop_closing, loops are closed. Null: neither.
@@ -242,13 +196,12 @@ struct SystemStats {
   int num_relocated_marker_poses = 0;  // marker poses located again in the final marker map
   int num_late_marker_poses = 0;       // frames without a pose located in it at the end
   int num_marker_only_poses = 0;  // frames whose pose came from markers alone
-  int num_world_alignments = 0;
+  WorldAnchoringStats world_anchoring;  // alignments to the marker world, drift corrections
   int num_marker_relocalizations = 0;  // tracking restarted from a marker pose
   int num_map_relocalizations = 0;     // loaded map: restarted from a keyframe match
   PlaceRecognitionStats places;        // relocalisation and loops (with a vocabulary)
   int num_marker_initializations = 0;  // maps initialised from two marker locations
   MapSessionStats map_session;         // resets, closed maps, merges and bridged gaps
-  int num_marker_corrections = 0;      // pose-graph corrections of drift by markers
   int num_whole_map_marker_adjustments = 0;  // bundle adjustments of a whole map with markers
   int num_refined_frame_poses = 0;  // frames re-optimised against the final map at Finish
   int num_yielded_bundle_adjustments = 0;  // local BAs ended early for a waiting keyframe
@@ -292,7 +245,7 @@ class System {
   std::vector<Eigen::Vector3d> MapPoints() const;
   const Map& map() const { return *map_; }
   TrackingState state() const { return tracker_ ? tracker_->state() : TrackingState::kNotInitialized; }
-  bool world_aligned() const { return world_aligned_; }
+  bool world_aligned() const { return anchoring_.aligned(); }
   // The known markers (fixed as in markers.json) and the ones mapped online (fixed: false).
   // Call after Finish. Empty without a marker map.
   MarkerMap MarkerMapOutput() const;
@@ -327,10 +280,6 @@ class System {
     double timestamp_s = 0.0;
     std::vector<MarkerObservation> markers;
   };
-  struct MarkerAnchor {
-    KeyframeId keyframe;
-    Rigid3 world_from_cam;
-  };
 
   void Initialize(Frame& frame, FrameReport& report);
   void Track(Frame& frame, FrameReport& report);
@@ -349,8 +298,7 @@ class System {
   void LocalizeInLoadedMap(Frame& frame, FrameReport& report);
   bool RelocalizeInLoadedMap(Frame& frame, FrameReport& report);
   std::optional<Rigid3> SeedPoseFromKeyframes(const Frame& frame);
-  void AddAnchor(KeyframeId keyframe, const std::optional<MarkerFix>& fix);
-  // Aligns the map to the world once enough anchors exist; `frame` (the current one, its
+  // Aligns the map to the world when anchoring_ decides so; `frame` (the current one, its
   // pose in the map) is carried along.
   void MaybeAlignWorld(Frame& frame);
   void RecordMarkerPose(const Frame& frame, FrameReport& report);
@@ -391,11 +339,6 @@ class System {
   // Mapping thread, after FeedMarkerMapping: the pose-graph correction when the keyframe's
   // markers contradict its pose (system_drift_correction.cc). True when the map moved.
   bool CorrectDriftWithMarkers(KeyframeId keyframe);
-  // The pose-graph prior of a keyframe from its marker location (standard deviations from
-  // the marker_priors options).
-  KeyframePosePrior MarkerPrior(KeyframeId keyframe, const MarkerFix& fix) const;
-  // The priors of every keyframe located by known markers alone (drift correction, loops).
-  std::vector<KeyframePosePrior> KnownMarkerPriors() const;
   std::shared_ptr<const MarkerMap> LocatingMarkers() const;
   void MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& report);
   void MapKeyframe(KeyframeId keyframe);
@@ -467,16 +410,13 @@ class System {
   // The current frame's marker location (fix()) and the state it is judged with.
   MarkerFusion marker_fusion_;
   std::optional<MarkerFix> init_reference_fix_;
-  std::vector<MarkerAnchor> anchors_;
-  bool world_aligned_ = false;
-  // Until the map is aligned, keyframes that saw a marker are not culled: they carry the
-  // alignment's anchors (read by the mapping thread's keyframe culling).
-  std::atomic<bool> keep_marker_keyframes_{true};
+  // The anchors, alignment decisions and marker priors of the current map.
+  WorldAnchoring anchoring_;
+  // With a marker map: keyframes anchoring_ keeps are not culled.
   void GuardMarkerKeyframes();
   // A new mapper_ for map_: marker-keyframe guard, and in threaded mode the BA's yield to a
   // waiting keyframe (yield_bundle_adjustment).
   void MakeLocalMapper();
-  int next_alignment_anchors_ = 0;  // alignment is tried again at this many anchors
   // Lost maps: reset, closed, merged into the next map, the gap bridged; the backfill.
   MapSession map_session_;
   double detection_ms_ = 0.0;  // marker detection time of the current image
@@ -497,10 +437,6 @@ class System {
   std::unique_ptr<PlaceRecognition> places_;  // with a vocabulary only
   std::uint64_t seen_corrections_ = 0;
   std::atomic<std::uint64_t> marker_corrections_{0};  // CorrectDriftWithMarkers, any map
-  // The marker location of every keyframe inserted with one (tracking thread writes, the
-  // mapping thread reads for drift correction).
-  mutable std::mutex keyframe_fixes_mutex_;
-  std::map<KeyframeId, MarkerFix> keyframe_fixes_;
   std::uint64_t seen_marker_corrections_ = 0;
   std::map<KeyframeId, Rigid3> keyframe_poses_;  // as of the previous frame (re-anchoring)
 

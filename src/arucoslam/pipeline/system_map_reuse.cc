@@ -32,14 +32,11 @@ void System::StartFromMap(MapData map, bool world_aligned, bool localize_only) {
   map_->Write([&map](MapData& data) { data = std::move(map); });
   map_loaded_ = true;
   localize_only_ = localize_only;
-  world_aligned_ = world_aligned;
-  keep_marker_keyframes_ = !world_aligned;
+  anchoring_.StartLoadedMap(world_aligned);
   if (places_) {
     places_->SetMetricMap(world_aligned);
     places_->IndexExistingKeyframes();
   }
-  // An aligned map is not aligned again (AddAnchor stops collecting anchors).
-  if (world_aligned) next_alignment_anchors_ = options_.max_realignment_anchors + 1;
 }
 
 void System::LocalizeInLoadedMap(Frame& frame, FrameReport& report) {

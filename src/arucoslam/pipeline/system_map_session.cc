@@ -13,7 +13,7 @@ namespace arucoslam {
 void System::HandleLostFrame(const Frame& frame, std::size_t frame_index) {
   LostMapState map;
   map.num_keyframes = map_->NumKeyframes();
-  map.world_aligned = world_aligned_;
+  map.world_aligned = anchoring_.aligned();
   map.frame_has_marker_fix = marker_fusion_.fix().has_value();
   map.loaded = map_loaded_;
   const LossAction action = map_session_.OnLostFrame(frame, map);
@@ -67,13 +67,7 @@ void System::ResetMap() {
   poses_ = std::move(kept);
   init_reference_.reset();
   init_reference_fix_.reset();
-  anchors_.clear();
-  {
-    std::lock_guard lock(keyframe_fixes_mutex_);
-    keyframe_fixes_.clear();
-  }
-  next_alignment_anchors_ = 0;
-  world_aligned_ = false;
+  anchoring_.Reset();
   marker_fusion_.MapReset();
   last_state_ = TrackingState::kNotInitialized;
   mapping_busy_ = false;
@@ -82,7 +76,7 @@ void System::ResetMap() {
 
 bool System::CloseMap() {
   const std::size_t keyframes = map_->NumKeyframes();
-  switch (map_session_.DecideClosing(keyframes, world_aligned_)) {
+  switch (map_session_.DecideClosing(keyframes, anchoring_.aligned())) {
     case MapClosing::kNothing:
     case MapClosing::kDiscarded:  // not in the world frame: ResetMap drops its poses
       return false;
@@ -100,10 +94,7 @@ bool System::CloseMap() {
                                                     KeyframePoses(), options_.pose_consistency);
   closing.keyframes = KeyframePoses();
   closing.points = MapPoints();
-  {
-    std::lock_guard lock(keyframe_fixes_mutex_);
-    closing.keyframe_fixes = keyframe_fixes_;
-  }
+  closing.keyframe_fixes = anchoring_.KeyframeFixes();
   return map_session_.CloseWorldMap(*map_, std::move(closing));
 }
 
@@ -134,10 +125,7 @@ bool System::MergeClosedMap() {
     }
     return 0;
   });
-  {
-    std::lock_guard lock(keyframe_fixes_mutex_);
-    for (const auto& [id, fix] : merged->keyframe_fixes) keyframe_fixes_[id] = fix;
-  }
+  anchoring_.AddKeyframeFixes(merged->keyframe_fixes);
   int revived = 0;
   if (marker_mapper_ && merged->marker_generation >= 0) {
     revived = marker_mapper_->ReviveClosedMap(merged->marker_generation, ids.keyframes);
@@ -156,10 +144,10 @@ bool System::MergeClosedMap() {
 
 void System::CorrectAcrossBridge() {
   if (!map_session_.HasBridgePriors()) return;
-  std::vector<KeyframePosePrior> marker_priors = KnownMarkerPriors();
+  std::vector<KeyframePosePrior> marker_priors = anchoring_.KnownMarkerPriors();
   if (places_) places_->MapMovedExternally();
   const EssentialGraphResult result = map_session_.CorrectAcrossBridge(
-      *map_, std::move(marker_priors), options_.marker_correction_graph);
+      *map_, std::move(marker_priors), options_.world_anchoring.marker_correction_graph);
   if (!result.applied) return;
   HandOutBridgePriors();
   if (places_) places_->RecordScaleChanges(result.scale_changes);

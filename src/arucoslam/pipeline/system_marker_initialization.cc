@@ -103,7 +103,8 @@ bool System::InitializeFromMarkers(Frame& frame, FrameReport& report) {
   anchors[1].keyframe = created.second;
   anchors[1].cam_from_map = *frame.cam_from_world;
   anchors[1].world_from_cam = world_from_cam2;
-  const WorldAlignment alignment = EstimateWorldFromMap(anchors, options_.alignment);
+  const WorldAlignment alignment =
+      EstimateWorldFromMap(anchors, options_.world_anchoring.alignment);
   if (!alignment.success) {
     // The map stays (unaligned); world alignment waits for more anchors as usual.
     ARUCOSLAM_LOG_DEBUG("frame {}: marker initialisation not aligned: {}", report.index,
@@ -118,15 +119,12 @@ bool System::InitializeFromMarkers(Frame& frame, FrameReport& report) {
   };
   first.cam_from_world = to_world(*first.cam_from_world);
   frame.cam_from_world = to_world(*frame.cam_from_world);
-  world_aligned_ = true;
+  anchoring_.AlignedFromMarkers();  // re-aligned as anchors come
   marker_fusion_.MapEnteredWorld(frame.timestamp_s);
-  keep_marker_keyframes_ = false;
   RefreshKeyframePoseCache();
-  next_alignment_anchors_ = options_.min_alignment_anchors;  // re-aligned as anchors come
   {
     std::lock_guard lock(stats_mutex_);
     ++stats_.num_marker_initializations;
-    ++stats_.num_world_alignments;
   }
   ARUCOSLAM_LOG_DEBUG("frame {}: map initialised from markers in the world, baseline {:.2f} m, "
                       "scale {:.3f}", report.index, baseline, world_from_map.scale);

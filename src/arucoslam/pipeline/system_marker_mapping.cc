@@ -30,9 +30,9 @@ void System::StartMarkerMapping() {
     // The caller holds the places' edit lock (LockPlacesForMapMove).
     if (places_) places_->SetMarkerLandmarks(marker_mapper_->mutable_landmarks());
   }
-  if (places_ && options_.marker_priors_in_loops) {
-    places_->SetLoopPosePriors([this] { return KnownMarkerPriors(); },
-                               options_.marker_correction_graph);
+  if (places_ && options_.world_anchoring.priors_in_loops) {
+    places_->SetLoopPosePriors([this] { return anchoring_.KnownMarkerPriors(); },
+                               options_.world_anchoring.marker_correction_graph);
   }
   // Keyframes mapped before the alignment are recorded now, at their aligned poses.
   const std::vector<KeyframeId> keyframes = map_->Read([&](const MapData& data) {

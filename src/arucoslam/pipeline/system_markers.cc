@@ -1,30 +1,14 @@
 // System's marker handling: each frame's markers handed to the marker fusion, marker-only
 // poses, relocalisation from a marker pose, and the Sim(3) alignment of the keypoint map to
 // the world.
-#include <algorithm>
+#include <optional>
 #include <set>
-#include <utility>
+#include <vector>
 
 #include "arucoslam/pipeline/system.h"
 #include "arucoslam/util/logging.h"
 
 namespace arucoslam {
-namespace {
-
-// Largest distance between two anchors' camera centres, metres.
-double Baseline(const std::vector<WorldAnchor>& anchors) {
-  double baseline = 0.0;
-  for (std::size_t i = 0; i < anchors.size(); ++i) {
-    for (std::size_t j = i + 1; j < anchors.size(); ++j) {
-      baseline = std::max(baseline, (anchors[i].world_from_cam.translation -
-                                     anchors[j].world_from_cam.translation).norm());
-    }
-  }
-  return baseline;
-}
-
-}  // namespace
-
 void System::LocateWithMarkers(Frame& frame, const std::vector<MarkerDetection>& detections,
                                FrameReport& report) {
   if (!options_.marker_map) return;
@@ -39,7 +23,7 @@ void System::LocateWithMarkers(Frame& frame, const std::vector<MarkerDetection>&
   }
   const std::shared_ptr<const MarkerMap> locating = LocatingMarkers();
   MapPrediction prediction;
-  prediction.world_aligned = world_aligned_;
+  prediction.world_aligned = anchoring_.aligned();
   prediction.tracking = tracker_->state() == TrackingState::kTracking;
   prediction.predicted_cam_from_map = tracker_->PredictedPose();
   marker_fusion_.Locate(detections, locating ? *locating : *options_.marker_map, frame.timestamp_s,
@@ -54,15 +38,13 @@ void System::LocateWithMarkers(Frame& frame, const std::vector<MarkerDetection>&
 
 void System::GuardMarkerKeyframes() {
   if (!options_.marker_map) return;
-  keep_marker_keyframes_ = true;
-  mapper_->SetKeyframeGuard([this](const Keyframe& keyframe) {
-    return keep_marker_keyframes_ && !keyframe.markers.empty();
-  });
+  mapper_->SetKeyframeGuard(
+      [this](const Keyframe& keyframe) { return anchoring_.KeepsKeyframe(keyframe); });
 }
 
 bool System::RelocalizeWithMarkers(Frame& frame, FrameReport& report) {
   const std::optional<MarkerFix>& fix = marker_fusion_.fix();
-  if (!world_aligned_ || !fix) return false;
+  if (!anchoring_.aligned() || !fix) return false;
   const TrackingResult result =
       tracker_->TrackFromPose(frame, fix->world_from_cam.Inverse(), fix->markers);
   if (result.state != TrackingState::kTracking) return false;
@@ -75,71 +57,25 @@ bool System::RelocalizeWithMarkers(Frame& frame, FrameReport& report) {
   return true;
 }
 
-void System::AddAnchor(KeyframeId keyframe, const std::optional<MarkerFix>& fix) {
-  if (!fix || !keyframe.IsValid()) return;
-  {
-    std::lock_guard lock(keyframe_fixes_mutex_);
-    keyframe_fixes_[keyframe] = *fix;
-  }
-  if (world_aligned_ && next_alignment_anchors_ > options_.max_realignment_anchors) return;
-  anchors_.push_back({keyframe, fix->world_from_cam});
-}
-
 void System::MaybeAlignWorld(Frame& frame) {
-  const int needed = std::max(options_.min_alignment_anchors, next_alignment_anchors_);
-  if (static_cast<int>(anchors_.size()) < needed) return;
-  std::vector<WorldAnchor> anchors;
-  std::vector<MarkerAnchor> live;  // anchors whose keyframe is still in the map
-  map_->Read([&](const MapData& data) {
-    for (const MarkerAnchor& anchor : anchors_) {
-      const Keyframe* keyframe = data.FindKeyframe(anchor.keyframe);
-      if (keyframe == nullptr) continue;
-      live.push_back(anchor);
-      WorldAnchor world_anchor;
-      world_anchor.keyframe = anchor.keyframe;
-      world_anchor.cam_from_map = keyframe->cam_from_world;
-      world_anchor.world_from_cam = anchor.world_from_cam;
-      anchors.push_back(world_anchor);
-    }
-    return 0;
-  });
-  anchors_ = std::move(live);
-  if (static_cast<int>(anchors.size()) < needed ||
-      Baseline(anchors) < options_.min_alignment_baseline_m) {
-    ARUCOSLAM_LOG_DEBUG("world alignment waits: {} anchors with keyframes ({} needed), baseline "
-                        "{:.2f} m", anchors.size(), needed, Baseline(anchors));
-    return;
-  }
-  const WorldAlignment alignment = EstimateWorldFromMap(anchors, options_.alignment);
-  if (!alignment.success || alignment.rms_m > options_.max_alignment_rms_m ||
-      (!world_aligned_ && alignment.world_from_map.scale > options_.max_alignment_scale)) {
-    ARUCOSLAM_LOG_DEBUG("world alignment refused ({} anchors): {} rms {:.3f} m, scale {:.2f}",
-                        anchors.size(), alignment.failure, alignment.rms_m,
-                        alignment.world_from_map.scale);
-    return;
-  }
+  const std::optional<AlignmentDecision> decision = anchoring_.DecideAlignment(*map_);
+  if (!decision) return;
+  const std::vector<WorldAnchor>& anchors = decision->anchors;
+  const WorldAlignment& alignment = decision->alignment;
   const Sim3& world_from_map = alignment.world_from_map;
   StopMappingThread();  // every queued keyframe is mapped first; mapping is idle below
   const std::set<KeyframeId>& absorbed = map_session_.absorbed_keyframes();
-  if (world_aligned_ && !absorbed.empty() && map_session_.LinkedToAbsorbedMap(*map_)) {
+  if (anchoring_.aligned() && !absorbed.empty() && map_session_.LinkedToAbsorbedMap(*map_)) {
     // A merged map that shares points with this one now (a loop, fused points): a
     // re-alignment from this map's anchors alone would tear them apart. Markers correct the
     // map by fusion from here on (drift correction, marker corners in bundle adjustment).
-    next_alignment_anchors_ = options_.max_realignment_anchors + 1;
-    anchors_.clear();
+    anchoring_.StopRealigning();
     mapping_busy_ = false;
     StartMappingThread();
     ARUCOSLAM_LOG_DEBUG("world re-alignment stopped: the merged map is linked to this one");
     return;
   }
-  {
-    // An anchor the alignment found an outlier has a wrong marker location (a mirrored
-    // one-marker solution, a far marker): no drift correction may pull the map towards it.
-    std::lock_guard lock(keyframe_fixes_mutex_);
-    for (std::size_t i = 0; i < anchors.size(); ++i) {
-      if (!alignment.inliers[i]) keyframe_fixes_.erase(anchors[i].keyframe);
-    }
-  }
+  anchoring_.DropOutlierFixes(*decision);
   // A merged map not linked yet stays where it is (already in the world).
   const std::set<KeyframeId>* stay = absorbed.empty() ? nullptr : &absorbed;
   const std::unique_lock<std::mutex> places_lock = LockPlacesForMapMove();
@@ -156,7 +92,7 @@ void System::MaybeAlignWorld(Frame& frame) {
   for (TrackedPose& pose : poses_) {
     // Marker-only and frozen poses (no reference) are in the world already; on a
     // re-alignment the poses tied to this map's keyframes move with them.
-    const bool moves = !pose.in_world || (world_aligned_ && pose.reference.IsValid() &&
+    const bool moves = !pose.in_world || (anchoring_.aligned() && pose.reference.IsValid() &&
                                            absorbed.count(pose.reference) == 0);
     if (!moves) continue;
     pose.cam_from_world = to_world(pose.cam_from_world);
@@ -164,20 +100,16 @@ void System::MaybeAlignWorld(Frame& frame) {
     pose.in_world = true;
   }
   if (frame.cam_from_world) frame.cam_from_world = to_world(*frame.cam_from_world);
-  next_alignment_anchors_ = 2 * static_cast<int>(anchors.size());
   if (MergeClosedMap()) CorrectAcrossBridge();
   mapping_busy_ = false;
   StartMappingThread();
   ARUCOSLAM_LOG_DEBUG("keypoint map {}aligned to the marker world: scale {:.4f}, {} of {} "
                       "anchors, rms {:.3f} m",
-                      world_aligned_ ? "re-" : "", world_from_map.scale, alignment.num_inliers,
-                      anchors.size(), alignment.rms_m);
-  world_aligned_ = true;
+                      anchoring_.aligned() ? "re-" : "", world_from_map.scale,
+                      alignment.num_inliers, anchors.size(), alignment.rms_m);
+  anchoring_.AlignmentApplied(*decision);
   marker_fusion_.MapEnteredWorld(frame.timestamp_s);  // the anchors agree with the map
-  keep_marker_keyframes_ = false;
   RefreshKeyframePoseCache();
-  std::lock_guard lock(stats_mutex_);
-  ++stats_.num_world_alignments;
 }
 
 void System::RecordMarkerPose(const Frame& frame, FrameReport& report) {

@@ -116,7 +116,7 @@ TEST(SystemMarkers, OptionsCheck) {
   SystemOptions options;
   options.marker_map = SceneMarkers();
   EXPECT_TRUE(options.Check());
-  options.min_alignment_anchors = 1;
+  options.world_anchoring.min_alignment_anchors = 1;
   EXPECT_FALSE(options.Check());
   for (const auto& breaks : std::vector<std::function<void(SystemOptions*)>>{
            [](SystemOptions* o) { o->marker_fusion.min_drift_interval_s = -1.0; },
@@ -136,7 +136,7 @@ TEST(SystemMarkers, BlockingRunIsInTheWorldFrameWithMetricScale) {
   // The map starts in the world from two marker locations, then is re-aligned once with
   // four anchors.
   EXPECT_EQ(run.stats.num_marker_initializations, 1);
-  EXPECT_EQ(run.stats.num_world_alignments, 2);
+  EXPECT_EQ(run.stats.world_anchoring.num_alignments, 2);
   EXPECT_EQ(run.invariants, "");
   // Every frame has a pose: the markers give one before the map is initialised.
   EXPECT_EQ(static_cast<int>(run.trajectory.size()), num_frames);
@@ -388,7 +388,7 @@ TEST(SystemMarkers, DriftThatTheMarkersRevealAfterAGapIsCorrectedNotRejected) {
   const DriftRun run = RunWithShiftedMarkers(ShiftAfterGap);
   EXPECT_EQ(run.stats.marker_fusion.num_drift_disagreements, 1);
   EXPECT_EQ(run.stats.marker_fusion.num_rejected_poses, 0);
-  EXPECT_GE(run.stats.num_marker_corrections, 1);
+  EXPECT_GE(run.stats.world_anchoring.num_drift_corrections, 1);
   EXPECT_EQ(run.stats.map_session.num_resets, 0);
   ASSERT_TRUE(run.reports[100].cam_from_world);
   EXPECT_FALSE(run.reports[100].marker_pose);
@@ -408,7 +408,7 @@ TEST(SystemMarkers, ThreadedDriftCorrectionSeesTheKeyframesMarkers) {
   });
   EXPECT_EQ(run.stats.marker_fusion.num_drift_disagreements, 1);
   EXPECT_EQ(run.stats.marker_fusion.num_rejected_poses, 0);
-  EXPECT_GE(run.stats.num_marker_corrections, 1);
+  EXPECT_GE(run.stats.world_anchoring.num_drift_corrections, 1);
   for (int t = 101; t < 140; ++t) {
     ASSERT_TRUE(run.reports[t].cam_from_world) << t;
     EXPECT_LT(DistanceFromMarkers(run, ShiftAfterGap, t), 0.5) << t;

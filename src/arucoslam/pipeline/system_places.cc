@@ -22,7 +22,8 @@ bool System::RelocalizeWithPlaces(Frame& frame, FrameReport& report) {
   if (!found) return false;
   // Look-alike places: in a map aligned to the marker world only a pose that the frame's
   // markers confirm is taken.
-  if (options_.marker_map && world_aligned_ && !marker_fusion_.Confirms(found->cam_from_world)) {
+  if (options_.marker_map && anchoring_.aligned() &&
+      !marker_fusion_.Confirms(found->cam_from_world)) {
     ARUCOSLAM_LOG_DEBUG("frame {}: place relocalisation not confirmed by markers", report.index);
     return false;
   }

@@ -19,6 +19,7 @@
 #include "arucoslam/slam/relocalizer.h"
 #include "arucoslam/slam/tracker.h"
 #include "arucoslam/slam/world_alignment.h"
+#include "arucoslam/slam/world_anchoring.h"
 #include "arucoslam/slam/covisible_marker_vote.h"
 #include "arucoslam/slam/world_rotation_vote.h"
 
@@ -309,6 +310,32 @@ void VisitOptions(MarkerFusionOptions& o, Visitor& visit) {
         "sooner: drift only when the disagreement grew at most this since the last, metres");
   visit("max_drift_correction_frames", o.max_drift_correction_frames,
         "frames that wait for a drift correction");
+}
+
+template <class Visitor>
+void VisitOptions(WorldAnchoringOptions& o, Visitor& visit) {
+  visit("alignment", o.alignment, "keypoint map to marker world alignment (Sim3)");
+  visit("min_alignment_anchors", o.min_alignment_anchors,
+        "world alignment waits for this many keyframes with a marker location");
+  visit("min_alignment_baseline_m", o.min_alignment_baseline_m,
+        "... whose camera centres span at least this, metres");
+  visit("max_alignment_rms_m", o.max_alignment_rms_m,
+        "alignment refused above this anchor residual, metres");
+  visit("max_alignment_scale", o.max_alignment_scale,
+        "a first alignment with a larger scale is refused (collapsed map)");
+  visit("max_realignment_anchors", o.max_realignment_anchors,
+        "realigned each time the anchors double, up to this many");
+  visit("drift_correction", o.drift_correction,
+        "pose-graph correction of the aligned map when a keyframe's markers disagree");
+  visit("min_marker_correction_m", o.min_marker_correction_m,
+        "a drift correction needs a disagreement beyond this, metres ...");
+  visit("marker_correction_sigmas", o.marker_correction_sigmas,
+        "... and beyond this many standard deviations of the marker pose");
+  visit("marker_priors", o.marker_priors, "keyframe marker locations as priors");
+  visit("marker_correction_graph", o.marker_correction_graph,
+        "the pose graph of marker corrections");
+  visit("priors_in_loops", o.priors_in_loops,
+        "loops in the aligned map corrected with the marker priors");
 }
 
 template <class Visitor>
