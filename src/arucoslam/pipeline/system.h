@@ -436,8 +436,7 @@ class System {
   std::size_t next_seed_keyframe_ = 0;  // round-robin position of SeedPoseFromKeyframes
   std::unique_ptr<PlaceRecognition> places_;  // with a vocabulary only
   std::uint64_t seen_corrections_ = 0;
-  std::atomic<std::uint64_t> marker_corrections_{0};  // CorrectDriftWithMarkers, any map
-  std::uint64_t seen_marker_corrections_ = 0;
+  int seen_marker_corrections_ = 0;  // anchoring_'s drift corrections FollowMapCorrections saw
   std::map<KeyframeId, Rigid3> keyframe_poses_;  // as of the previous frame (re-anchoring)
 
   std::unique_ptr<BoundedQueue<KeyframeId>> queue_;

@@ -26,7 +26,6 @@ bool System::CorrectDriftWithMarkers(KeyframeId keyframe) {
                       result.num_priors, result.summary.BriefReport());
   if (!result.applied) return false;
   if (places_) places_->RecordScaleChanges(result.scale_changes);
-  ++marker_corrections_;
   anchoring_.DriftCorrected();
   return true;
 }

@@ -87,10 +87,11 @@ void System::RefreshKeyframePoseCache() {
 void System::FollowMapCorrections() {
   if (places_) ReanchorOrphanPoses();
   const bool places_moved = places_ && places_->corrections() != seen_corrections_;
-  const bool markers_moved = marker_corrections_ != seen_marker_corrections_;
+  const int marker_corrections = anchoring_.stats().num_drift_corrections;
+  const bool markers_moved = marker_corrections != seen_marker_corrections_;
   if (!places_moved && !markers_moved) return;
   if (places_) seen_corrections_ = places_->corrections();
-  seen_marker_corrections_ = marker_corrections_;
+  seen_marker_corrections_ = marker_corrections;
   if (tracker_->state() != TrackingState::kTracking || poses_.empty()) return;
   const TrackedPose& last = poses_.back();
   const std::optional<Rigid3> reference = map_->Read([&](const MapData& data) {

@@ -72,12 +72,11 @@ std::optional<AlignmentDecision> WorldAnchoring::DecideAlignment(const Map& map)
     return 0;
   });
   anchors_ = std::move(live);
-  if (static_cast<int>(anchors.size()) < needed ||
-      Baseline(anchors) < options_.min_alignment_baseline_m) {
+  const double baseline_m = Baseline(anchors);
+  if (static_cast<int>(anchors.size()) < needed || baseline_m < options_.min_alignment_baseline_m) {
     ARUCOSLAM_LOG_DEBUG(
-        "world alignment waits: {} anchors with keyframes ({} needed), baseline "
-        "{:.2f} m",
-        anchors.size(), needed, Baseline(anchors));
+        "world alignment waits: {} anchors with keyframes ({} needed), baseline {:.2f} m",
+        anchors.size(), needed, baseline_m);
     return std::nullopt;
   }
   decision.alignment = EstimateWorldFromMap(anchors, options_.alignment);
