@@ -105,9 +105,6 @@ SystemOptions DefaultRunOptions(bool blocking, std::shared_ptr<const Vocabulary>
                                 bool loop_closing) {
   SystemOptions options;
   options.blocking = blocking;
-  // Low-contrast cells: 5 grey levels (extractor default 7) keeps keypoints on the faint marks
-  // of plain walls; the medium-texture route's U-turn facing one stays tracked.
-  options.extractor.min_fast_threshold = 5;
   options.vocabulary = std::move(vocabulary);
   options.places.loop_closing = loop_closing;
   return options;

@@ -95,12 +95,12 @@ TEST(ConfigFileTest, OneKeyChangesOneOption) {
   expected.tracker.motion_search.base_radius_px = 12.5;
   EXPECT_EQ(SystemOptionsYaml(read), SystemOptionsYaml(expected));
 
-  // Over other starting values (run's): keys left out keep them.
+  // Over other starting values: keys left out keep them.
   SystemOptions start;
-  start.extractor.min_fast_threshold = 5;
+  start.extractor.min_fast_threshold = 6;
   const SystemOptions over = Parse("extractor: {num_features: 1500}\nblocking: false\n", start);
   EXPECT_EQ(over.extractor.num_features, 1500);
-  EXPECT_EQ(over.extractor.min_fast_threshold, 5);
+  EXPECT_EQ(over.extractor.min_fast_threshold, 6);
   EXPECT_FALSE(over.blocking);
   // Integers are numbers too; an empty file changes nothing.
   EXPECT_EQ(

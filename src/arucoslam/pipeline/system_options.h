@@ -25,7 +25,13 @@
 namespace arucoslam {
 
 struct SystemOptions {
-  OrbExtractorOptions extractor;
+  // The extractor's defaults, but 5 grey levels for the FAST threshold of low-contrast cells
+  // (the extractor's own default is 7): keypoints stay on the faint marks of plain walls.
+  OrbExtractorOptions extractor = [] {
+    OrbExtractorOptions options;
+    options.min_fast_threshold = 5;
+    return options;
+  }();
   InitializerOptions initializer;
   InitialMapOptions initial_map;
   TrackerOptions tracker;
