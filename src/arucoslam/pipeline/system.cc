@@ -1,7 +1,6 @@
 #include "arucoslam/pipeline/system.h"
 
 #include <algorithm>
-#include <set>
 #include <stdexcept>
 #include <utility>
 
@@ -32,6 +31,8 @@ System::System(const CameraModel& camera, const SystemOptions& options)
       options_(options),
       extractor_(options.extractor),
       initializer_(options.initializer),
+      pose_history_(options.refine_frame_poses,
+                    [this](KeyframeId id) { return places_ ? places_->KeyframeScale(id) : 1.0; }),
       marker_fusion_(MakeMarkerFusion(options, camera)),
       anchoring_(options.world_anchoring),
       map_session_(options.map_session, options.marker_map.has_value()) {
@@ -86,16 +87,22 @@ void System::Finish() {
   StopMappingThread();
   if (places_) places_->Finish();
   FinishMarkerMapping();
-  RelocateMarkerPoses();
-  RefineFramePoses();
+  std::optional<MarkerRelocationCounts> relocated;
+  if (marker_mapper_ && options_.relocate_marker_poses) {
+    relocated = pose_history_.RelocateInMarkerMap(marker_mapper_->ToMarkerMap(), marker_fusion_);
+  }
+  int num_refined = 0;
+  if (options_.refine_frame_poses) {
+    FramePoseRefinement refinement{options_.tracker.marker_pose, options_.tracker.min_pose_inliers,
+                                   options_.refine_min_inlier_fraction};
+    refinement.optimization.keypoints = options_.tracker.pose;
+    num_refined =
+        pose_history_.RefineAgainstMap(*map_, PinholeIntrinsics::FromCamera(camera_), refinement);
+  }
   int num_inconsistent = 0;
   const std::vector<StampedPose> trajectory = CheckedTrajectory(&num_inconsistent);
   // Frames seen without a pose or a marker that a backfill or the end posed do not count.
-  std::set<double> posed;
-  for (const StampedPose& pose : trajectory) posed.insert(pose.timestamp_s);
-  const int unposed_without_markers = static_cast<int>(std::count_if(
-      unposed_without_markers_s_.begin(), unposed_without_markers_s_.end(),
-      [&](double timestamp_s) { return posed.count(timestamp_s) == 0; }));
+  const int unposed_without_markers = pose_history_.CountUnposedWithoutMarkers(trajectory);
   if (num_inconsistent > 0) {
     ARUCOSLAM_LOG_DEBUG("{} frames left out of the trajectory: off their keyframes' path",
                         num_inconsistent);
@@ -103,6 +110,11 @@ void System::Finish() {
   std::lock_guard lock(stats_mutex_);
   stats_.num_inconsistent_poses = num_inconsistent;
   stats_.num_unposed_without_markers = unposed_without_markers;
+  if (relocated) {
+    stats_.num_relocated_marker_poses = relocated->num_relocated;
+    stats_.num_late_marker_poses = relocated->num_late;
+  }
+  if (options_.refine_frame_poses) stats_.num_refined_frame_poses = num_refined;
 }
 
 void System::WaitForMapping() {
@@ -135,7 +147,8 @@ void System::MapKeyframe(KeyframeId keyframe) {
   const double elapsed = watch.ElapsedMilliseconds();
   if (places_) {
     edit.unlock();
-    if (options_.blocking) ReanchorOrphanPoses();  // before a loop correction moves the map
+    // Before a loop correction moves the map.
+    if (options_.blocking) pose_history_.ReanchorOrphans(*map_);
     places_->KeyframeMapped(keyframe);
   }
   ARUCOSLAM_LOG_DEBUG(
@@ -214,7 +227,7 @@ FrameReport System::ProcessFrame(Frame frame, const std::vector<MarkerDetection>
   // location), a frame that saw markers may be located at the end.
   const bool world_pose = report.cam_from_world && (anchoring_.aligned() || fix);
   if (!world_pose && !frame.markers.empty()) {
-    unposed_marker_frames_.push_back({frame.timestamp_s, frame.markers});
+    pose_history_.NoteUnposedMarkerFrame(frame.timestamp_s, frame.markers);
   }
   report.world_aligned = anchoring_.aligned();
   if (fix) report.marker_world_from_cam = fix->world_from_cam;
@@ -228,7 +241,7 @@ FrameReport System::ProcessFrame(Frame frame, const std::vector<MarkerDetection>
     if (report.cam_from_world) ++stats_.num_tracked;
     if (report.state == TrackingState::kLost) ++stats_.num_lost;
     if (options_.marker_map && !report.cam_from_world && frame.markers.empty()) {
-      unposed_without_markers_s_.push_back(frame.timestamp_s);
+      pose_history_.NoteUnposedWithoutMarkers(frame.timestamp_s);
     }
     stats_.tracking_ms.Add(watch.ElapsedMilliseconds());
     stats_.marker_fusion = marker_fusion_.stats();
@@ -283,16 +296,9 @@ void System::FinishInitialization(Frame& first, Frame& frame, KeyframeId first_i
                                   KeyframeId second_id, int num_points, FrameReport& report) {
   init_reference_.reset();
   tracker_->Start(frame, second_id);
-  RecordPose(first, first_id);
-  // The reference frame may have got a marker-only pose when it was seen: that entry is
-  // replaced in place (the order of poses_ stays the order of time).
-  for (std::size_t i = 0; i + 1 < poses_.size(); ++i) {
-    if (poses_[i].timestamp_s == first.timestamp_s) {
-      poses_[i] = poses_.back();
-      poses_.pop_back();
-      break;
-    }
-  }
+  // The reference frame may have got a marker-only pose when it was seen: replaced in place.
+  pose_history_.Record(*map_, first, first_id, anchoring_.aligned(), marker_fusion_.fix(),
+                       /*in_place=*/true);
   RecordPose(frame, second_id);
   BackfillInitialization(frame, first_id, second_id);
   if (places_) {
@@ -414,40 +420,7 @@ void System::MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& rep
 }
 
 void System::RecordPose(const Frame& frame, KeyframeId reference) {
-  poses_.push_back(MakeTrackedPose(frame, reference));
-}
-
-System::TrackedPose System::MakeTrackedPose(const Frame& frame, KeyframeId reference) const {
-  TrackedPose pose;
-  pose.timestamp_s = frame.timestamp_s;
-  pose.reference = reference;
-  pose.cam_from_world = *frame.cam_from_world;
-  pose.in_world = anchoring_.aligned();
-  const std::optional<MarkerFix>& fix = marker_fusion_.fix();
-  if (!anchoring_.aligned() && fix) {
-    pose.marker_cam_from_world = fix->world_from_cam.Inverse();
-    pose.seen_markers = frame.markers;
-  }
-  const std::optional<Rigid3> reference_pose = map_->Read([&](const MapData& data) {
-    const Keyframe* keyframe = data.FindKeyframe(reference);
-    return keyframe ? std::optional<Rigid3>(keyframe->cam_from_world) : std::nullopt;
-  });
-  if (!reference_pose) pose.reference = KeyframeId();
-  pose.reference_scale = ReferenceScale(pose.reference);
-  pose.cam_from_reference =
-      reference_pose ? pose.cam_from_world * reference_pose->Inverse() : pose.cam_from_world;
-  if (options_.refine_frame_poses && reference_pose) {
-    for (std::size_t i = 0; i < frame.map_point_ids.size(); ++i) {
-      if (!frame.map_point_ids[i].IsValid() || (i < frame.outliers.size() && frame.outliers[i])) {
-        continue;
-      }
-      const int index = static_cast<int>(i);
-      pose.matches.push_back({frame.map_point_ids[i], frame.UndistortedPixel(index).cast<float>(),
-                              static_cast<float>(frame.SigmaPx(index))});
-    }
-    if (anchoring_.aligned() && fix && fix->known_markers_only) pose.markers = fix->markers;
-  }
-  return pose;
+  pose_history_.Record(*map_, frame, reference, anchoring_.aligned(), marker_fusion_.fix());
 }
 
 std::vector<StampedPose> System::Trajectory() const { return CheckedTrajectory(nullptr); }
@@ -458,30 +431,11 @@ std::vector<StampedPose> System::CheckedTrajectory(int* num_dropped) const {
           map_session_.BiggerClosedMapPoses(map_->NumKeyframes())) {
     return *closed;
   }
-  std::vector<StampedPose> poses = CurrentMapPoses(/*world_only=*/options_.marker_map.has_value());
+  std::vector<StampedPose> poses =
+      pose_history_.CurrentMapPoses(*map_, /*world_only=*/options_.marker_map.has_value());
   // A loaded map's keyframes were timed in another run: they do not bracket these frames.
   if (!options_.drop_inconsistent_poses || map_loaded_) return poses;
   return DropPosesOffTheirKeyframes(poses, KeyframePoses(), options_.pose_consistency, num_dropped);
-}
-
-std::vector<StampedPose> System::CurrentMapPoses(bool world_only) const {
-  std::vector<StampedPose> trajectory;
-  map_->Read([&](const MapData& data) {
-    for (const TrackedPose& pose : poses_) {
-      if (world_only && !pose.in_world) {
-        if (pose.marker_cam_from_world) {
-          trajectory.push_back({pose.timestamp_s, pose.marker_cam_from_world->Inverse()});
-        }
-        continue;
-      }
-      const Keyframe* reference = data.FindKeyframe(pose.reference);
-      const Rigid3 cam_from_world =
-          reference ? PoseFromReference(pose, reference->cam_from_world) : pose.cam_from_world;
-      trajectory.push_back({pose.timestamp_s, cam_from_world.Inverse()});
-    }
-    return 0;
-  });
-  return trajectory;
 }
 
 std::vector<StampedPose> System::KeyframePoses() const {

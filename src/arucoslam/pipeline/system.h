@@ -37,6 +37,7 @@
 #include "arucoslam/slam/map_session.h"
 #include "arucoslam/slam/marker_fusion.h"
 #include "arucoslam/slam/marker_mapper.h"
+#include "arucoslam/slam/pose_history.h"
 #include "arucoslam/slam/tracker.h"
 #include "arucoslam/slam/world_anchoring.h"
 #include "arucoslam/util/timing.h"
@@ -88,34 +89,6 @@ class System {
   SystemStats Stats() const;
 
  private:
-  struct FrameMatch {  // a keypoint of a tracked frame and the map point it matched
-    MapPointId point;
-    Eigen::Vector2f pixel;  // undistorted
-    float sigma_px = 1.0f;
-  };
-  struct TrackedPose {
-    double timestamp_s = 0.0;
-    KeyframeId reference;
-    Rigid3 cam_from_reference;
-    double reference_scale = 1.0;  // the reference's KeyframeScale when recorded (loops)
-    Rigid3 cam_from_world;
-    bool in_world = false;  // expressed in the marker world (kept across map resets)
-    // Frozen with a closed map that may still be merged: its reference keyframe there.
-    KeyframeId closed_reference;
-    // What tracking matched in the frame (refine_frame_poses; emptied at Finish).
-    std::vector<FrameMatch> matches;
-    std::vector<MarkerPoseObservation> markers;  // known markers only
-    // The frame's marker location while its map is not in the world: its pose if the map
-    // never gets there.
-    std::optional<Rigid3> marker_cam_from_world;
-    // The markers a frame posed by markers saw (RelocateMarkerPoses).
-    std::vector<MarkerObservation> seen_markers;
-  };
-  struct UnposedMarkerFrame {  // a frame that saw markers but got no pose
-    double timestamp_s = 0.0;
-    std::vector<MarkerObservation> markers;
-  };
-
   void Initialize(Frame& frame, FrameReport& report);
   void Track(Frame& frame, FrameReport& report);
   // Marker handling (system_markers.cc): the frame's markers and their location
@@ -123,10 +96,6 @@ class System {
   void LocateWithMarkers(Frame& frame, const std::vector<MarkerDetection>& detections,
                          FrameReport& report);
   bool RelocalizeWithMarkers(Frame& frame, FrameReport& report);
-  // Finish, when markers were mapped: the frames posed by markers are located again in the
-  // final marker map, and the frames that saw markers but got no pose are located in it
-  // (system_marker_relocation.cc).
-  void RelocateMarkerPoses();
   // Map reuse (system_map_reuse.cc): a frame before the first localisation in a loaded map,
   // and the keyframe-seeded relocalisation (brute-force matching against a few keyframes
   // per frame, pose-only optimisation, then TrackFromPose).
@@ -141,18 +110,10 @@ class System {
   void MakePlaceRecognition();
   bool RelocalizeWithPlaces(Frame& frame, FrameReport& report);
   // After a loop correction or global BA: the tracker's last pose follows its reference
-  // keyframe into the corrected map. Also re-anchors poses whose reference keyframe was
-  // culled to the keyframe nearest in time, so that later corrections move them too.
+  // keyframe into the corrected map; poses of culled keyframes are re-anchored first.
   void FollowMapCorrections();
-  // A tracked pose from its reference keyframe's pose; the offset follows the scale changes
-  // that loop corrections applied around the reference since the pose was recorded.
-  Rigid3 PoseFromReference(const TrackedPose& pose, const Rigid3& reference_cam_from_world) const;
-  double ReferenceScale(KeyframeId reference) const;
-  void ReanchorOrphanPoses();
-  // Finish: refine_frame_poses (system_frame_refinement.cc).
-  void RefineFramePoses();
-  // The map was moved as a whole (world alignment): the cached keyframe poses that
-  // ReanchorOrphanPoses compares against are re-read.
+  // The map was moved as a whole (world alignment): the keyframe poses that the
+  // re-anchoring compares against are re-read.
   void RefreshKeyframePoseCache();
   // Held while the map is moved from outside (world alignment); empty without places.
   std::unique_lock<std::mutex> LockPlacesForMapMove();
@@ -177,9 +138,7 @@ class System {
   std::shared_ptr<const MarkerMap> LocatingMarkers() const;
   void MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& report);
   void MapKeyframe(KeyframeId keyframe);
-  // A frame's tracked pose against its reference keyframe, with what tracking matched in it
-  // (refine_frame_poses), and the same added to poses_.
-  TrackedPose MakeTrackedPose(const Frame& frame, KeyframeId reference) const;
+  // A frame's tracked pose against its reference keyframe, added to pose_history_.
   void RecordPose(const Frame& frame, KeyframeId reference);
   // Map sessions (system_map_session.cc): map_session_'s decisions carried out on the map,
   // the poses, the marker mapper and the place recognition.
@@ -214,8 +173,6 @@ class System {
                             KeyframeId second_id, int num_points, FrameReport& report);
   // Trajectory, and how many poses drop_inconsistent_poses left out (null: not counted).
   std::vector<StampedPose> CheckedTrajectory(int* num_dropped) const;
-  // Poses of the current map in its own frame (reference keyframes' final poses).
-  std::vector<StampedPose> CurrentMapPoses(bool world_only) const;
   void StartMappingThread();
   void StopMappingThread();
   bool MapperIdle() const;
@@ -231,7 +188,7 @@ class System {
   std::size_t num_frames_ = 0;
   int frames_since_keyframe_ = 0;
   TrackingState last_state_ = TrackingState::kNotInitialized;
-  std::vector<TrackedPose> poses_;
+  PoseHistory pose_history_;  // every frame's pose
   std::optional<KeyframeId> pending_keyframe_;  // blocking mode: to map after tracking
 
   std::unique_ptr<MarkerDetector> detector_;  // with a marker map only
@@ -258,8 +215,6 @@ class System {
   double marker_wait_ms_ = 0.0;  // the current image's wait for its detections
   // Markers of the world-aligned map; only the mapping thread touches it while it runs.
   std::unique_ptr<MarkerMapper> marker_mapper_;
-  std::vector<UnposedMarkerFrame> unposed_marker_frames_;
-  std::vector<double> unposed_without_markers_s_;  // frames seen without pose nor marker
   int marker_views_refined_ = 0;  // marker views at the last refinement (FeedMarkerView)
   bool marker_mapping_live_ = false;  // the current map is aligned and feeds marker_mapper_
   // Known + mapped markers that locate frames, published by the mapping thread.
@@ -272,7 +227,6 @@ class System {
   std::unique_ptr<PlaceRecognition> places_;  // with a vocabulary only
   std::uint64_t seen_corrections_ = 0;
   int seen_marker_corrections_ = 0;  // anchoring_'s drift corrections FollowMapCorrections saw
-  std::map<KeyframeId, Rigid3> keyframe_poses_;  // as of the previous frame (re-anchoring)
 
   std::unique_ptr<BoundedQueue<KeyframeId>> queue_;
   std::thread mapping_thread_;

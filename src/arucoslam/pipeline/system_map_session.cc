@@ -28,32 +28,8 @@ void System::HandleLostFrame(const Frame& frame, std::size_t frame_index) {
 void System::ResetMap() {
   StopMappingThread();
   const bool kept_for_merge = CloseMap();
-  // Poses already in the world frame stay, frozen at their current estimate (those of a map
-  // kept for a merge remember their keyframe there).
-  std::vector<TrackedPose> kept;
-  map_->Read([&](const MapData& data) {
-    for (TrackedPose pose : poses_) {
-      if (!pose.in_world && pose.marker_cam_from_world) {  // frozen at its marker location
-        pose.cam_from_world = *pose.marker_cam_from_world;
-        pose.cam_from_reference = pose.cam_from_world;
-        pose.reference = KeyframeId();
-        pose.in_world = true;
-      }
-      if (!pose.in_world) continue;
-      if (kept_for_merge) pose.closed_reference = KeyframeId();  // an older closed map's
-      if (const Keyframe* reference = data.FindKeyframe(pose.reference)) {
-        pose.cam_from_world = PoseFromReference(pose, reference->cam_from_world);
-        if (kept_for_merge) pose.closed_reference = pose.reference;
-      }
-      pose.reference = KeyframeId();
-      if (!pose.closed_reference.IsValid()) {  // frozen for good: never refined
-        pose.matches = {};
-        pose.markers = {};
-      }
-      kept.push_back(std::move(pose));
-    }
-    return 0;
-  });
+  // Poses already in the world frame stay, frozen at their current estimate.
+  pose_history_.FreezeForReset(*map_, kept_for_merge);
   places_.reset();
   tracker_.reset();
   mapper_.reset();
@@ -64,7 +40,6 @@ void System::ResetMap() {
   const int marker_generation = ResetMarkerMapping();
   map_session_.StartNewMap(kept_for_merge ? std::optional<int>(marker_generation) : std::nullopt);
   HandOutBridgePriors();  // none: the new places hold none yet, the marker mapper drops them
-  poses_ = std::move(kept);
   init_reference_.reset();
   init_reference_fix_.reset();
   anchoring_.Reset();
@@ -81,7 +56,8 @@ bool System::CloseMap() {
     case MapClosing::kDiscarded:  // not in the world frame: ResetMap drops its poses
       return false;
     case MapClosing::kBiggestKeypointMap:
-      map_session_.KeepBiggestKeypointMap(CurrentMapPoses(/*world_only=*/false), keyframes);
+      map_session_.KeepBiggestKeypointMap(
+          pose_history_.CurrentMapPoses(*map_, /*world_only=*/false), keyframes);
       return false;
     case MapClosing::kInWorld:
       break;
@@ -90,8 +66,9 @@ bool System::CloseMap() {
   AdjustWholeMapWithMarkers("map closed");
   ClosingWorldMap closing;
   // Frames off their keyframes (a plain wall before the loss) would bend the bridge's velocity.
-  closing.motion_poses = DropPosesOffTheirKeyframes(CurrentMapPoses(/*world_only=*/true),
-                                                    KeyframePoses(), options_.pose_consistency);
+  closing.motion_poses =
+      DropPosesOffTheirKeyframes(pose_history_.CurrentMapPoses(*map_, /*world_only=*/true),
+                                 KeyframePoses(), options_.pose_consistency);
   closing.keyframes = KeyframePoses();
   closing.points = MapPoints();
   closing.keyframe_fixes = anchoring_.KeyframeFixes();
@@ -103,28 +80,7 @@ bool System::MergeClosedMap() {
   if (!merged) return false;
   const AbsorbedIds& ids = merged->ids;
   // Its frozen poses follow their keyframes again.
-  int followed = 0;
-  map_->Read([&](const MapData& data) {
-    for (TrackedPose& pose : poses_) {
-      if (!pose.closed_reference.IsValid()) continue;
-      const auto found = ids.keyframes.find(pose.closed_reference);
-      pose.closed_reference = KeyframeId();
-      if (found == ids.keyframes.end()) continue;
-      pose.reference = found->second;
-      std::vector<FrameMatch> matches;  // its points have new ids here
-      for (const FrameMatch& match : pose.matches) {
-        const auto point = ids.points.find(match.point);
-        if (point != ids.points.end())
-          matches.push_back({point->second, match.pixel, match.sigma_px});
-      }
-      pose.matches = std::move(matches);
-      pose.cam_from_reference =
-          pose.cam_from_world * data.FindKeyframe(found->second)->cam_from_world.Inverse();
-      pose.reference_scale = ReferenceScale(found->second);
-      ++followed;
-    }
-    return 0;
-  });
+  const int followed = pose_history_.FollowMergedMap(*map_, ids);
   anchoring_.AddKeyframeFixes(merged->keyframe_fixes);
   int revived = 0;
   if (marker_mapper_ && merged->marker_generation >= 0) {
@@ -170,25 +126,9 @@ void System::BackfillInitialization(const Frame& second, KeyframeId first_id,
   const std::vector<Frame> tracked =
       map_session_.TrackBackfill(*map_, options_.tracker, second, first_id, second_id);
   if (tracked.empty()) return;
-  // Marker-only poses of the same frames give way to the keypoint ones; time order is kept.
-  std::vector<TrackedPose> merged;
-  merged.reserve(poses_.size() + tracked.size());
-  int num_replaced = 0;
-  for (TrackedPose& pose : poses_) {
-    const bool replaced = std::any_of(tracked.begin(), tracked.end(), [&](const Frame& frame) {
-      return frame.timestamp_s == pose.timestamp_s;
-    });
-    if (replaced) {
-      ++num_replaced;
-    } else {
-      merged.push_back(std::move(pose));
-    }
-  }
-  for (const Frame& frame : tracked) merged.push_back(MakeTrackedPose(frame, first_id));
-  std::stable_sort(merged.begin(), merged.end(), [](const TrackedPose& a, const TrackedPose& b) {
-    return a.timestamp_s < b.timestamp_s;
-  });
-  poses_ = std::move(merged);
+  // Marker-only poses of the same frames give way to the keypoint ones.
+  const int num_replaced = pose_history_.MergeBackfill(*map_, tracked, first_id,
+                                                       anchoring_.aligned(), marker_fusion_.fix());
   std::lock_guard lock(stats_mutex_);
   stats_.num_tracked += static_cast<int>(tracked.size()) - num_replaced;  // newly with a pose
 }

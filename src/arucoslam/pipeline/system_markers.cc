@@ -86,20 +86,10 @@ void System::MaybeAlignWorld(Frame& frame) {
   if (mapped != nullptr) marker_mapper_->ApplySimilarity(world_from_map, stay);
   StartMarkerMapping();
   tracker_->ApplySimilarity(world_from_map);
-  const auto to_world = [&](const Rigid3& cam_from_map) {
-    return world_from_map.TransformPose(cam_from_map.Inverse()).Inverse();
-  };
-  for (TrackedPose& pose : poses_) {
-    // Marker-only and frozen poses (no reference) are in the world already; on a
-    // re-alignment the poses tied to this map's keyframes move with them.
-    const bool moves = !pose.in_world || (anchoring_.aligned() && pose.reference.IsValid() &&
-                                           absorbed.count(pose.reference) == 0);
-    if (!moves) continue;
-    pose.cam_from_world = to_world(pose.cam_from_world);
-    pose.cam_from_reference.translation *= world_from_map.scale;
-    pose.in_world = true;
+  pose_history_.MoveIntoWorld(world_from_map, /*realigned=*/anchoring_.aligned(), absorbed);
+  if (frame.cam_from_world) {
+    frame.cam_from_world = world_from_map.TransformPose(frame.cam_from_world->Inverse()).Inverse();
   }
-  if (frame.cam_from_world) frame.cam_from_world = to_world(*frame.cam_from_world);
   if (MergeClosedMap()) CorrectAcrossBridge();
   mapping_busy_ = false;
   StartMappingThread();
@@ -116,13 +106,7 @@ void System::RecordMarkerPose(const Frame& frame, FrameReport& report) {
   const Rigid3 cam_from_world = marker_fusion_.fix()->world_from_cam.Inverse();
   report.cam_from_world = cam_from_world;
   report.marker_pose = true;
-  TrackedPose pose;
-  pose.timestamp_s = frame.timestamp_s;
-  pose.cam_from_reference = cam_from_world;
-  pose.cam_from_world = cam_from_world;
-  pose.in_world = true;
-  pose.seen_markers = frame.markers;
-  poses_.push_back(pose);
+  pose_history_.RecordMarkerPose(frame, cam_from_world);
   std::lock_guard lock(stats_mutex_);
   ++stats_.num_marker_only_poses;
 }
