@@ -11,8 +11,8 @@
 namespace arucoslam {
 
 void System::RelocateMarkerPoses() {
-  if (!marker_mapper_ || !options_.relocate_marker_poses) return;
-  const MarkerMap final_map = marker_mapper_->ToMarkerMap();
+  if (!marker_mapping_.has_mapper() || !options_.relocate_marker_poses) return;
+  const MarkerMap final_map = marker_mapping_.ToMarkerMap();
   const bool any_mapped = std::any_of(final_map.markers.begin(), final_map.markers.end(),
                                       [](const auto& entry) { return !entry.second.fixed; });
   if (!any_mapped) return;  // the frames were located in this map already
