@@ -10,18 +10,21 @@
 namespace arucoslam {
 namespace {
 
-void WaitIgnoringErrors(MarkerDetectorWorker& worker) {
-  try {
-    worker.Wait();
-  } catch (...) {
-  }
-}
-
 MarkerFusion MakeMarkerFusion(const SystemOptions& options, const CameraModel& camera) {
   if (!options.marker_map) return MarkerFusion(options.marker_fusion, camera, MarkerMap(), 0.0);
   const double unknown_size =
       UnknownMarkerSize(*options.marker_map, options.marker_mapping.unknown_marker_size_m);
   return MarkerFusion(options.marker_fusion, camera, *options.marker_map, unknown_size);
+}
+
+OnlineMarkerMappingOptions MarkerMappingOptions(const SystemOptions& options) {
+  OnlineMarkerMappingOptions mapping;
+  mapping.mapper = options.marker_mapping;
+  mapping.map_unknown_markers = options.map_unknown_markers;
+  mapping.markers_in_local_ba = options.markers_in_local_ba;
+  mapping.whole_map_adjustment = options.whole_map_marker_adjustment;
+  mapping.min_locating_keyframes = options.min_locating_marker_keyframes;
+  return mapping;
 }
 
 }  // namespace
@@ -35,7 +38,8 @@ System::System(const CameraModel& camera, const SystemOptions& options)
                     [this](KeyframeId id) { return places_ ? places_->KeyframeScale(id) : 1.0; }),
       marker_fusion_(MakeMarkerFusion(options, camera)),
       anchoring_(options.world_anchoring),
-      map_session_(options.map_session, options.marker_map.has_value()) {
+      map_session_(options.map_session, options.marker_map.has_value()),
+      marker_mapping_(options.marker_map, MarkerMappingOptions(options)) {
   if (std::string why; !options_.Check(&why)) {
     throw std::invalid_argument("System: invalid SystemOptions: " + why);
   }
@@ -43,10 +47,8 @@ System::System(const CameraModel& camera, const SystemOptions& options)
   tracker_ = std::make_unique<Tracker>(*map_, options_.tracker);
   MakeLocalMapper();
   if (options_.marker_map) {
-    detector_ = std::make_unique<MarkerDetector>(options_.detector);
-    detector_worker_ = std::make_unique<MarkerDetectorWorker>(*detector_);
-    marker_search_ =
-        std::make_unique<MarkerSearchPlanner>(camera_, options_.detector, options_.marker_search);
+    marker_frontend_ =
+        std::make_unique<MarkerFrontend>(camera_, options_.detector, options_.marker_search);
   }
   MakePlaceRecognition();
   StartMappingThread();
@@ -86,10 +88,14 @@ void System::Finish() {
   finished_ = true;
   StopMappingThread();
   if (places_) places_->Finish();
-  FinishMarkerMapping();
+  if (marker_mapping_.AdjustsWholeMap()) {
+    AdjustWholeMapWithMarkers("end of the run");
+  } else {
+    marker_mapping_.RefineMappedMarkers(*map_);
+  }
   std::optional<MarkerRelocationCounts> relocated;
-  if (marker_mapper_ && options_.relocate_marker_poses) {
-    relocated = pose_history_.RelocateInMarkerMap(marker_mapper_->ToMarkerMap(), marker_fusion_);
+  if (marker_mapping_.has_mapper() && options_.relocate_marker_poses) {
+    relocated = pose_history_.RelocateInMarkerMap(marker_mapping_.ToMarkerMap(), marker_fusion_);
   }
   int num_refined = 0;
   if (options_.refine_frame_poses) {
@@ -140,7 +146,7 @@ void System::MapKeyframe(KeyframeId keyframe) {
   const Stopwatch watch;
   std::unique_lock<std::mutex> edit;  // a loop being closed pauses local mapping
   if (places_) edit = places_->LockMapEdits();
-  FeedMarkerMapping(keyframe);
+  marker_mapping_.AddKeyframe(*map_, keyframe);
   CorrectDriftWithMarkers(keyframe);
   const LocalMappingResult r = mapper_->ProcessKeyframe(keyframe);
   const bool yielded = r.bundle_adjustment.summary.stopped_early;
@@ -175,26 +181,20 @@ FrameReport System::ProcessImage(const cv::Mat& grey, double timestamp_s) {
   frame.camera = camera_;
   // Marker detection runs on the worker's thread meanwhile; the frame waits only for what
   // is left of it after extraction.
-  if (detector_worker_) detector_worker_->Start(grey, MarkerSearchRegions());
+  if (marker_frontend_) marker_frontend_->StartDetection(grey, *marker_mapping_.LocatingMarkers());
   try {
     frame.features = extractor_.Extract(grey);
   } catch (...) {
-    if (detector_worker_) WaitIgnoringErrors(*detector_worker_);
+    if (marker_frontend_) marker_frontend_->AbandonDetection();
     throw;
   }
   UndistortFeatures(camera_, &frame.features);
   frame.ResetMatches();
   const double extraction = watch.ElapsedMilliseconds();
   std::vector<MarkerDetection> detections;
-  if (detector_worker_) {
-    const Stopwatch waiting;
-    TimedDetections detected = detector_worker_->Wait();
-    marker_wait_ms_ = waiting.ElapsedMilliseconds();
-    detection_ms_ = detected.wall_ms;
-    detections = std::move(detected.detections);
-  }
+  if (marker_frontend_) detections = marker_frontend_->WaitForDetections();
   FrameReport report = ProcessFrame(std::move(frame), detections);
-  if (detector_worker_) RememberMarkerView(report, detections);
+  if (marker_frontend_) marker_frontend_->RememberFrame(report, marker_fusion_.fix(), detections);
   report.markers = std::move(detections);
   std::lock_guard lock(stats_mutex_);
   stats_.extraction_ms.Add(extraction);
@@ -222,7 +222,7 @@ FrameReport System::ProcessFrame(Frame frame, const std::vector<MarkerDetection>
   // A loaded map that stays outside the marker world takes no marker-only poses.
   const bool marker_poses = anchoring_.aligned() || !localize_only_;
   if (!report.cam_from_world && fix && marker_poses) RecordMarkerPose(frame, report);
-  if (!localize_only_) FeedMarkerView(frame);
+  if (!localize_only_) marker_mapping_.AddMarkerView(frame, marker_fusion_.fix());
   // Without a world pose now (none, or a keypoint pose outside the world without a marker
   // location), a frame that saw markers may be located at the end.
   const bool world_pose = report.cam_from_world && (anchoring_.aligned() || fix);
@@ -469,6 +469,13 @@ SystemStats System::Stats() const {
   std::lock_guard lock(stats_mutex_);
   SystemStats stats = stats_;
   stats.world_anchoring = anchoring_.stats();
+  stats.num_whole_map_marker_adjustments = marker_mapping_.stats().num_whole_map_adjustments;
+  if (marker_frontend_) {
+    MarkerFrontendStats markers = marker_frontend_->stats();
+    stats.marker_ms = std::move(markers.marker_ms);
+    stats.marker_wait_ms = std::move(markers.wait_ms);
+    stats.num_full_marker_scans = markers.num_full_scans;
+  }
   return stats;
 }
 

@@ -21,12 +21,11 @@
 #include "arucoslam/map/map.h"
 #include "arucoslam/markers/camera_locator.h"
 #include "arucoslam/markers/detector.h"
-#include "arucoslam/markers/detector_regions.h"
 #include "arucoslam/markers/marker_map.h"
 #include "arucoslam/optim/essential_graph.h"
 #include "arucoslam/optim/marker_factors.h"
 #include "arucoslam/pipeline/bounded_queue.h"
-#include "arucoslam/pipeline/marker_detector_worker.h"
+#include "arucoslam/pipeline/marker_frontend.h"
 #include "arucoslam/pipeline/place_recognition.h"
 #include "arucoslam/pipeline/system_options.h"
 #include "arucoslam/pipeline/system_report.h"
@@ -36,7 +35,7 @@
 #include "arucoslam/slam/map_initialization.h"
 #include "arucoslam/slam/map_session.h"
 #include "arucoslam/slam/marker_fusion.h"
-#include "arucoslam/slam/marker_mapper.h"
+#include "arucoslam/slam/online_marker_mapping.h"
 #include "arucoslam/slam/pose_history.h"
 #include "arucoslam/slam/tracker.h"
 #include "arucoslam/slam/world_anchoring.h"
@@ -91,8 +90,8 @@ class System {
  private:
   void Initialize(Frame& frame, FrameReport& report);
   void Track(Frame& frame, FrameReport& report);
-  // Marker handling (system_markers.cc): the frame's markers and their location
-  // (marker_fusion_), with a marker map only.
+  // Marker handling (system_markers.cc): the frame's markers located by marker_frontend_ with
+  // marker_fusion_, with a marker map only.
   void LocateWithMarkers(Frame& frame, const std::vector<MarkerDetection>& detections,
                          FrameReport& report);
   bool RelocalizeWithMarkers(Frame& frame, FrameReport& report);
@@ -117,25 +116,15 @@ class System {
   void RefreshKeyframePoseCache();
   // Held while the map is moved from outside (world alignment); empty without places.
   std::unique_lock<std::mutex> LockPlacesForMapMove();
-  // Marker mapping (system_marker_mapping.cc). Start: on each world alignment, with the
-  // mapping thread stopped. Feed: a keyframe's markers, before its local mapping. Reset:
-  // after the map was replaced. Finish: final marker refinement.
+  // Marker mapping (system_marker_mapping.cc): marker_mapping_ wired to the map, the local
+  // mapper and the places. Start: on each world alignment, with the mapping thread stopped.
   void StartMarkerMapping();
-  void FeedMarkerMapping(KeyframeId keyframe);
-  // Tracking thread, while no map is in the world: a frame posed by markers maps unknown
-  // markers as a marker view (MarkerMapper::AddMarkerView).
-  void FeedMarkerView(const Frame& frame);
-  MarkerMapper& EnsureMarkerMapper();
-  int ResetMarkerMapping();  // the closed map's marker generation (-1: no mapper)
-  void FinishMarkerMapping();
   // Bundle adjustment of the whole world-aligned map with every marker view (`when` is for
   // the log); the mapping thread must be stopped and the places' edit lock free.
   void AdjustWholeMapWithMarkers(const char* when);
-  void PublishLocatingMarkers();  // mapping thread, after a keyframe's markers were added
-  // Mapping thread, after FeedMarkerMapping: the pose-graph correction when the keyframe's
-  // markers contradict its pose (system_drift_correction.cc). True when the map moved.
+  // Mapping thread, after the keyframe's markers were mapped: the pose-graph correction when
+  // they contradict its pose. True when the map moved.
   bool CorrectDriftWithMarkers(KeyframeId keyframe);
-  std::shared_ptr<const MarkerMap> LocatingMarkers() const;
   void MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& report);
   void MapKeyframe(KeyframeId keyframe);
   // A frame's tracked pose against its reference keyframe, added to pose_history_.
@@ -191,14 +180,7 @@ class System {
   PoseHistory pose_history_;  // every frame's pose
   std::optional<KeyframeId> pending_keyframe_;  // blocking mode: to map after tracking
 
-  std::unique_ptr<MarkerDetector> detector_;  // with a marker map only
-  std::unique_ptr<MarkerDetectorWorker> detector_worker_;  // runs detector_, with it
-  std::unique_ptr<MarkerSearchPlanner> marker_search_;     // with detector_
-  // Where the current image's markers are searched (nullopt: the whole image), and after
-  // the frame, what the next one's search needs (system_marker_search.cc).
-  std::optional<std::vector<cv::Rect>> MarkerSearchRegions();
-  void RememberMarkerView(const FrameReport& report,
-                          const std::vector<MarkerDetection>& detections);
+  std::unique_ptr<MarkerFrontend> marker_frontend_;  // with a marker map only
   // The current frame's marker location (fix()) and the state it is judged with.
   MarkerFusion marker_fusion_;
   std::optional<MarkerFix> init_reference_fix_;
@@ -211,15 +193,9 @@ class System {
   void MakeLocalMapper();
   // Lost maps: reset, closed, merged into the next map, the gap bridged; the backfill.
   MapSession map_session_;
-  double detection_ms_ = 0.0;  // marker detection time of the current image
-  double marker_wait_ms_ = 0.0;  // the current image's wait for its detections
-  // Markers of the world-aligned map; only the mapping thread touches it while it runs.
-  std::unique_ptr<MarkerMapper> marker_mapper_;
-  int marker_views_refined_ = 0;  // marker views at the last refinement (FeedMarkerView)
-  bool marker_mapping_live_ = false;  // the current map is aligned and feeds marker_mapper_
-  // Known + mapped markers that locate frames, published by the mapping thread.
-  mutable std::mutex locating_mutex_;
-  std::shared_ptr<const MarkerMap> locating_markers_;
+  // Markers mapped in the world; only the mapping thread touches it while it runs and the map
+  // is live.
+  OnlineMarkerMapping marker_mapping_;
 
   bool map_loaded_ = false;    // started from a saved map (StartFromMap)
   bool localize_only_ = false;

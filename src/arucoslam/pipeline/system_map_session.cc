@@ -37,7 +37,7 @@ void System::ResetMap() {
   tracker_ = std::make_unique<Tracker>(*map_, options_.tracker);
   MakeLocalMapper();
   MakePlaceRecognition();
-  const int marker_generation = ResetMarkerMapping();
+  const int marker_generation = marker_mapping_.CloseMap();
   map_session_.StartNewMap(kept_for_merge ? std::optional<int>(marker_generation) : std::nullopt);
   HandOutBridgePriors();  // none: the new places hold none yet, the marker mapper drops them
   init_reference_.reset();
@@ -82,10 +82,7 @@ bool System::MergeClosedMap() {
   // Its frozen poses follow their keyframes again.
   const int followed = pose_history_.FollowMergedMap(*map_, ids);
   anchoring_.AddKeyframeFixes(merged->keyframe_fixes);
-  int revived = 0;
-  if (marker_mapper_ && merged->marker_generation >= 0) {
-    revived = marker_mapper_->ReviveClosedMap(merged->marker_generation, ids.keyframes);
-  }
+  const int revived = marker_mapping_.ReviveClosedMap(merged->marker_generation, ids.keyframes);
   if (places_) {
     std::vector<KeyframeId> absorbed;
     for (const auto& [old_id, id] : ids.keyframes) absorbed.push_back(id);
@@ -111,7 +108,7 @@ void System::CorrectAcrossBridge() {
 
 void System::HandOutBridgePriors() {
   const std::vector<KeyframePosePrior>& priors = map_session_.held_bridge_priors();
-  if (marker_mapper_) marker_mapper_->SetPositionPriors(priors);
+  marker_mapping_.SetPositionPriors(priors);
   if (places_) places_->SetBundleAdjustmentPriors(priors);
 }
 

@@ -11,29 +11,15 @@
 namespace arucoslam {
 void System::LocateWithMarkers(Frame& frame, const std::vector<MarkerDetection>& detections,
                                FrameReport& report) {
-  if (!options_.marker_map) return;
-  const Stopwatch watch;
-  if (options_.marker_map->markers.empty() && !detections.empty() && !marker_mapping_live_ &&
-      EnsureMarkerMapper().AdoptWorldOrigin(detections, frame.camera)) {
-    PublishLocatingMarkers();
-  }
-  frame.markers.clear();
-  for (const MarkerDetection& detection : detections) {
-    frame.markers.push_back({MarkerId(detection.id), detection.corners});
-  }
-  const std::shared_ptr<const MarkerMap> locating = LocatingMarkers();
+  if (!marker_frontend_) return;
+  marker_mapping_.AdoptWorldOrigin(detections, frame.camera);
   MapPrediction prediction;
   prediction.world_aligned = anchoring_.aligned();
   prediction.tracking = tracker_->state() == TrackingState::kTracking;
   prediction.predicted_cam_from_map = tracker_->PredictedPose();
-  marker_fusion_.Locate(detections, locating ? *locating : *options_.marker_map, frame.timestamp_s,
-                        prediction, report.index);
+  marker_frontend_->Locate(detections, *marker_mapping_.LocatingMarkers(), prediction,
+                           report.index, &frame, &marker_fusion_);
   report.num_markers = marker_fusion_.num_markers();
-  std::lock_guard lock(stats_mutex_);
-  const double locating_ms = watch.ElapsedMilliseconds();
-  stats_.marker_ms.Add(detection_ms_ + locating_ms);
-  stats_.marker_wait_ms.Add(marker_wait_ms_ + locating_ms);
-  detection_ms_ = marker_wait_ms_ = 0.0;
 }
 
 void System::GuardMarkerKeyframes() {
@@ -80,10 +66,9 @@ void System::MaybeAlignWorld(Frame& frame) {
   const std::set<KeyframeId>* stay = absorbed.empty() ? nullptr : &absorbed;
   const std::unique_lock<std::mutex> places_lock = LockPlacesForMapMove();
   // On a re-alignment the markers mapped in the previous estimate of the world move too.
-  MarkerLandmarks* mapped =
-      marker_mapping_live_ ? marker_mapper_->mutable_landmarks() : nullptr;
+  MarkerLandmarks* mapped = marker_mapping_.live_landmarks();
   map_->Write([&](MapData& data) { ApplyWorldAlignment(world_from_map, &data, mapped, stay); });
-  if (mapped != nullptr) marker_mapper_->ApplySimilarity(world_from_map, stay);
+  marker_mapping_.ApplySimilarity(world_from_map, stay);
   StartMarkerMapping();
   tracker_->ApplySimilarity(world_from_map);
   pose_history_.MoveIntoWorld(world_from_map, /*realigned=*/anchoring_.aligned(), absorbed);

@@ -96,7 +96,7 @@ struct SystemOptions {
   int min_frames_between_anchor_keyframes = 1;
   // Once the map is world-aligned, keyframes' marker observations join local BA and the
   // global BA after a loop (known markers fixed) and markers the map lacks are mapped
-  // (system_marker_mapping.cc).
+  // (slam/online_marker_mapping.h).
   bool markers_in_local_ba = true;
   bool map_unknown_markers = true;
   // A world-aligned map gets one bundle adjustment of all its keyframes and points with every
