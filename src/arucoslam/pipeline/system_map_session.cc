@@ -65,8 +65,7 @@ void System::ResetMap() {
   map_session_.StartNewMap(kept_for_merge ? std::optional<int>(marker_generation) : std::nullopt);
   HandOutBridgePriors();  // none: the new places hold none yet, the marker mapper drops them
   poses_ = std::move(kept);
-  init_reference_.reset();
-  init_reference_fix_.reset();
+  map_initializer_.Reset();
   anchoring_.Reset();
   marker_fusion_.MapReset();
   last_state_ = TrackingState::kNotInitialized;
@@ -157,12 +156,6 @@ void System::HandOutBridgePriors() {
   const std::vector<KeyframePosePrior>& priors = map_session_.held_bridge_priors();
   if (marker_mapper_) marker_mapper_->SetPositionPriors(priors);
   if (places_) places_->SetBundleAdjustmentPriors(priors);
-}
-
-void System::ReplaceInitReference(const Frame& frame) {
-  if (init_reference_) map_session_.KeepForBackfill(*init_reference_);
-  init_reference_ = frame;
-  init_reference_fix_ = marker_fusion_.fix();
 }
 
 void System::BackfillInitialization(const Frame& second, KeyframeId first_id,
