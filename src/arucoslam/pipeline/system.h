@@ -202,7 +202,8 @@ class System {
   // The frames kept for the backfill, tracked from `second` back in time: each one tracked
   // gets a pose, in place of a marker-only pose of the same frame.
   void BackfillInitialization(const Frame& second, KeyframeId first_id, KeyframeId second_id);
-  // The first map's two keyframes (map_initializer_'s) start tracking, the poses, the anchors.
+  // The first map (map_initializer_'s) carried out: tracking starts from `frame`, both frames
+  // get their poses and anchors, the backfill is tracked and the map may align to the world.
   void FinishInitialization(const InitialMap& initial, Frame& frame, FrameReport& report);
   // Trajectory, and how many poses drop_inconsistent_poses left out (null: not counted).
   std::vector<StampedPose> CheckedTrajectory(int* num_dropped) const;
