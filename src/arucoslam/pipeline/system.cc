@@ -17,7 +17,7 @@ MarkerFusion MakeMarkerFusion(const SystemOptions& options, const CameraModel& c
   return MarkerFusion(options.marker_fusion, camera, *options.marker_map, unknown_size);
 }
 
-OnlineMarkerMappingOptions MarkerMappingOptions(const SystemOptions& options) {
+OnlineMarkerMappingOptions MakeMarkerMappingOptions(const SystemOptions& options) {
   OnlineMarkerMappingOptions mapping;
   mapping.mapper = options.marker_mapping;
   mapping.map_unknown_markers = options.map_unknown_markers;
@@ -27,19 +27,31 @@ OnlineMarkerMappingOptions MarkerMappingOptions(const SystemOptions& options) {
   return mapping;
 }
 
+MapInitializerOptions MakeMapInitializerOptions(const SystemOptions& options) {
+  MapInitializerOptions initialization;
+  initialization.two_view = options.initializer;
+  initialization.initial_map = options.initial_map;
+  initialization.max_reference_gap_s = options.max_initialization_gap_s;
+  initialization.markers.min_baseline_m = options.min_marker_init_baseline_m;
+  initialization.markers.min_parallax_deg = options.min_marker_init_parallax_deg;
+  initialization.markers.alignment = options.world_anchoring.alignment;
+  return initialization;
+}
+
 }  // namespace
 
 System::System(const CameraModel& camera, const SystemOptions& options)
     : camera_(camera),
       options_(options),
       extractor_(options.extractor),
-      initializer_(options.initializer),
+      map_initializer_(camera, MakeMapInitializerOptions(options)),
       pose_history_(options.refine_frame_poses,
                     [this](KeyframeId id) { return places_ ? places_->KeyframeScale(id) : 1.0; }),
       marker_fusion_(MakeMarkerFusion(options, camera)),
       anchoring_(options.world_anchoring),
       map_session_(options.map_session, options.marker_map.has_value()),
-      marker_mapping_(options.marker_map, MarkerMappingOptions(options)) {
+      marker_mapping_(options.marker_map, MakeMarkerMappingOptions(options)),
+      loaded_map_relocalizer_(options.tracker) {
   if (std::string why; !options_.Check(&why)) {
     throw std::invalid_argument("System: invalid SystemOptions: " + why);
   }
@@ -256,45 +268,29 @@ FrameReport System::ProcessFrame(Frame frame, const std::vector<MarkerDetection>
 
 void System::Initialize(Frame& frame, FrameReport& report) {
   report.state = TrackingState::kNotInitialized;
-  const bool enough = report.num_features >= options_.initializer.min_matches;
-  if (!init_reference_ ||
-      frame.timestamp_s - init_reference_->timestamp_s > options_.max_initialization_gap_s) {
-    if (enough) ReplaceInitReference(frame);
-    report.message = enough ? "initialisation reference" : "too few features";
-    return;
-  }
-  {
+  InitializationStep step = map_initializer_.Step(*map_, frame, marker_fusion_.fix(), report.index);
+  report.message = std::move(step.message);
+  if (step.attempted) {
     std::lock_guard lock(stats_mutex_);
     ++stats_.num_initialization_attempts;
   }
-  if (InitializeFromMarkers(frame, report)) return;
-  const InitializationResult result =
-      initializer_.Initialize(init_reference_->features, frame.features, camera_);
-  report.message = result.message;
-  ARUCOSLAM_LOG_DEBUG("frame {}: initialisation {}: {}", report.index,
-                      result.success ? "succeeded" : InitFailureName(result.failure),
-                      result.message);
-  if (!result.success) {
-    if (result.failure == InitFailure::kTooFewMatches && enough) {
-      ReplaceInitReference(frame);
-    } else {
-      map_session_.KeepForBackfill(frame);
-    }
-    return;
+  if (step.for_backfill) map_session_.KeepForBackfill(*step.for_backfill);
+  if (!step.map) return;
+  if (step.map->in_world) {
+    anchoring_.AlignedFromMarkers();  // re-aligned as anchors come
+    marker_fusion_.MapEnteredWorld(frame.timestamp_s);
+    RefreshKeyframePoseCache();
+    std::lock_guard lock(stats_mutex_);
+    ++stats_.num_marker_initializations;
   }
-  Frame first = *init_reference_;
-  const InitialMapResult created =
-      CreateInitialMap(*map_, first, frame, result, options_.initial_map);
-  if (!created.success) {
-    report.message = created.message;
-    return;
-  }
-  FinishInitialization(first, frame, created.first, created.second, created.num_points, report);
+  FinishInitialization(*step.map, frame, report);
+  if (step.map->in_world) report.message += " (from markers, in the world)";
 }
 
-void System::FinishInitialization(Frame& first, Frame& frame, KeyframeId first_id,
-                                  KeyframeId second_id, int num_points, FrameReport& report) {
-  init_reference_.reset();
+void System::FinishInitialization(const InitialMap& initial, Frame& frame, FrameReport& report) {
+  const Frame& first = initial.first;
+  const KeyframeId first_id = initial.first_id;
+  const KeyframeId second_id = initial.second_id;
   tracker_->Start(frame, second_id);
   // The reference frame may have got a marker-only pose when it was seen: replaced in place.
   pose_history_.Record(*map_, first, first_id, anchoring_.aligned(), marker_fusion_.fix(),
@@ -306,9 +302,8 @@ void System::FinishInitialization(Frame& first, Frame& frame, KeyframeId first_i
     places_->KeyframeMapped(second_id);
   }
   map_session_.AddBridgePrior(first_id, first.timestamp_s, anchoring_.aligned());
-  anchoring_.AddAnchor(first_id, init_reference_fix_);
+  anchoring_.AddAnchor(first_id, initial.first_fix);
   anchoring_.AddAnchor(second_id, marker_fusion_.fix());
-  init_reference_fix_.reset();
   MaybeAlignWorld(frame);
   frames_since_keyframe_ = 0;
   last_state_ = TrackingState::kTracking;
@@ -316,8 +311,8 @@ void System::FinishInitialization(Frame& first, Frame& frame, KeyframeId first_i
   report.cam_from_world = frame.cam_from_world;
   report.initialized_map = true;
   report.new_keyframe = true;
-  report.num_inliers = num_points;
-  report.message = "map initialised with " + std::to_string(num_points) + " points";
+  report.num_inliers = initial.num_points;
+  report.message = "map initialised with " + std::to_string(initial.num_points) + " points";
   std::lock_guard lock(stats_mutex_);
   ++stats_.num_initializations;
   stats_.num_keyframes_inserted += 2;

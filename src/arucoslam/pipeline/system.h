@@ -31,8 +31,9 @@
 #include "arucoslam/pipeline/system_report.h"
 #include "arucoslam/slam/initializer.h"
 #include "arucoslam/slam/keyframe_policy.h"
+#include "arucoslam/slam/loaded_map_relocalizer.h"
 #include "arucoslam/slam/local_mapper.h"
-#include "arucoslam/slam/map_initialization.h"
+#include "arucoslam/slam/map_initializer.h"
 #include "arucoslam/slam/map_session.h"
 #include "arucoslam/slam/marker_fusion.h"
 #include "arucoslam/slam/online_marker_mapping.h"
@@ -96,11 +97,9 @@ class System {
                          FrameReport& report);
   bool RelocalizeWithMarkers(Frame& frame, FrameReport& report);
   // Map reuse (system_map_reuse.cc): a frame before the first localisation in a loaded map,
-  // and the keyframe-seeded relocalisation (brute-force matching against a few keyframes
-  // per frame, pose-only optimisation, then TrackFromPose).
+  // and the keyframe-seeded relocalisation (loaded_map_relocalizer_).
   void LocalizeInLoadedMap(Frame& frame, FrameReport& report);
   bool RelocalizeInLoadedMap(Frame& frame, FrameReport& report);
-  std::optional<Rigid3> SeedPoseFromKeyframes(const Frame& frame);
   // Aligns the map to the world when anchoring_ decides so; `frame` (the current one, its
   // pose in the map) is carried along.
   void MaybeAlignWorld(Frame& frame);
@@ -148,18 +147,12 @@ class System {
   // Hands map_session_'s held bridge priors to the marker mapper and the place recognition;
   // the caller holds the places' edit lock (LockPlacesForMapMove) or has just made them anew.
   void HandOutBridgePriors();
-  // `frame` becomes the initialisation reference, with its marker location; the reference it
-  // replaces is kept for the backfill.
-  void ReplaceInitReference(const Frame& frame);
   // The frames kept for the backfill, tracked from `second` back in time: each one tracked
   // gets a pose, in place of a marker-only pose of the same frame.
   void BackfillInitialization(const Frame& second, KeyframeId first_id, KeyframeId second_id);
-  // Marker initialisation (system_marker_initialization.cc): builds the initial map from the
-  // marker poses of the reference and `frame` directly in the world; false when the marker
-  // poses do not allow it (the caller initialises as usual).
-  bool InitializeFromMarkers(Frame& frame, FrameReport& report);
-  void FinishInitialization(Frame& first, Frame& frame, KeyframeId first_id,
-                            KeyframeId second_id, int num_points, FrameReport& report);
+  // The first map (map_initializer_'s) carried out: tracking starts from `frame`, both frames
+  // get their poses and anchors, the backfill is tracked and the map may align to the world.
+  void FinishInitialization(const InitialMap& initial, Frame& frame, FrameReport& report);
   // Trajectory, and how many poses drop_inconsistent_poses left out (null: not counted).
   std::vector<StampedPose> CheckedTrajectory(int* num_dropped) const;
   void StartMappingThread();
@@ -169,11 +162,10 @@ class System {
   CameraModel camera_;
   SystemOptions options_;
   OrbExtractor extractor_;
-  Initializer initializer_;
+  MapInitializer map_initializer_;
   std::unique_ptr<Map> map_;
   std::unique_ptr<Tracker> tracker_;
   std::unique_ptr<LocalMapper> mapper_;
-  std::optional<Frame> init_reference_;
   std::size_t num_frames_ = 0;
   int frames_since_keyframe_ = 0;
   TrackingState last_state_ = TrackingState::kNotInitialized;
@@ -183,7 +175,6 @@ class System {
   std::unique_ptr<MarkerFrontend> marker_frontend_;  // with a marker map only
   // The current frame's marker location (fix()) and the state it is judged with.
   MarkerFusion marker_fusion_;
-  std::optional<MarkerFix> init_reference_fix_;
   // The anchors, alignment decisions and marker priors of the current map.
   WorldAnchoring anchoring_;
   // With a marker map: keyframes anchoring_ keeps are not culled.
@@ -199,7 +190,7 @@ class System {
 
   bool map_loaded_ = false;    // started from a saved map (StartFromMap)
   bool localize_only_ = false;
-  std::size_t next_seed_keyframe_ = 0;  // round-robin position of SeedPoseFromKeyframes
+  LoadedMapRelocalizer loaded_map_relocalizer_;  // without places only
   std::unique_ptr<PlaceRecognition> places_;  // with a vocabulary only
   std::uint64_t seen_corrections_ = 0;
   int seen_marker_corrections_ = 0;  // anchoring_'s drift corrections FollowMapCorrections saw

@@ -40,8 +40,7 @@ void System::ResetMap() {
   const int marker_generation = marker_mapping_.CloseMap();
   map_session_.StartNewMap(kept_for_merge ? std::optional<int>(marker_generation) : std::nullopt);
   HandOutBridgePriors();  // none: the new places hold none yet, the marker mapper drops them
-  init_reference_.reset();
-  init_reference_fix_.reset();
+  map_initializer_.Reset();
   anchoring_.Reset();
   marker_fusion_.MapReset();
   last_state_ = TrackingState::kNotInitialized;
@@ -110,12 +109,6 @@ void System::HandOutBridgePriors() {
   const std::vector<KeyframePosePrior>& priors = map_session_.held_bridge_priors();
   marker_mapping_.SetPositionPriors(priors);
   if (places_) places_->SetBundleAdjustmentPriors(priors);
-}
-
-void System::ReplaceInitReference(const Frame& frame) {
-  if (init_reference_) map_session_.KeepForBackfill(*init_reference_);
-  init_reference_ = frame;
-  init_reference_fix_ = marker_fusion_.fix();
 }
 
 void System::BackfillInitialization(const Frame& second, KeyframeId first_id,

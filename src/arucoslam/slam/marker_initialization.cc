@@ -1,16 +1,15 @@
-// System's map initialisation from two marker locations: the matches triangulated with the
-// markers' relative pose, the map built directly in the marker world.
-#include <algorithm>
+#include "arucoslam/slam/marker_initialization.h"
+
 #include <cmath>
 #include <numbers>
-#include <utility>
+#include <optional>
+#include <vector>
 
 #include "arucoslam/feature/orb_matcher.h"
 #include "arucoslam/geometry/triangulation.h"
-#include "arucoslam/pipeline/system.h"
-#include "arucoslam/slam/map_initialization.h"
 #include "arucoslam/util/logging.h"
 #include "arucoslam/util/median.h"
+#include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
 namespace {
@@ -42,8 +41,8 @@ InitializationResult TriangulateWithKnownMotion(const Frame& frame1, const Frame
     if (!point) continue;
     const TriangulationQuality quality = EvaluateTriangulation(
         *point, identity, cam2_from_cam1, n1, n2, frame1.camera.fx, frame1.camera.fy);
-    if (!(quality.depth1 > 0.0) || !(quality.depth2 > 0.0) ||
-        quality.error1_sq_px > max_error_sq || quality.error2_sq_px > max_error_sq) {
+    if (!(quality.depth1 > 0.0) || !(quality.depth2 > 0.0) || quality.error1_sq_px > max_error_sq ||
+        quality.error2_sq_px > max_error_sq) {
       continue;
     }
     result.matches.push_back(match);
@@ -53,8 +52,8 @@ InitializationResult TriangulateWithKnownMotion(const Frame& frame1, const Frame
   const int num_points = static_cast<int>(result.matches.size());
   result.median_parallax_deg = Median(parallaxes);
   result.cam2_from_cam1 = cam2_from_cam1;
-  result.success = num_points >= options.min_triangulated &&
-                   result.median_parallax_deg >= min_parallax_deg;
+  result.success =
+      num_points >= options.min_triangulated && result.median_parallax_deg >= min_parallax_deg;
   result.message = std::to_string(num_points) + " of " + std::to_string(matches.size()) +
                    " matches triangulated with the marker poses, median parallax " +
                    std::to_string(result.median_parallax_deg) + " deg";
@@ -63,74 +62,73 @@ InitializationResult TriangulateWithKnownMotion(const Frame& frame1, const Frame
 
 }  // namespace
 
-bool System::InitializeFromMarkers(Frame& frame, FrameReport& report) {
-  const std::optional<MarkerFix>& fix = marker_fusion_.fix();
-  if (!fix) return false;
-  if (!init_reference_fix_) {
-    // A reference with a marker location allows the metric initialisation below.
-    if (report.num_features >= options_.initializer.min_matches) {
-      ReplaceInitReference(frame);
-      report.message = "initialisation reference (markers)";
-      return true;
-    }
-    return false;
+bool MarkerInitializationOptions::Check(std::string* why) const {
+  OptionCheck check(why);
+  check.Above("min_baseline_m", min_baseline_m, 0.0);
+  check.AtLeast("min_parallax_deg", min_parallax_deg, 0.0);
+  check.Nested("alignment", alignment);
+  return check.ok();
+}
+
+MarkerInitializer::MarkerInitializer(const MarkerInitializationOptions& options,
+                                     const InitializerOptions& two_view,
+                                     const InitialMapOptions& initial_map)
+    : options_(options), two_view_(two_view), initial_map_(initial_map) {}
+
+MarkerInitializationResult MarkerInitializer::Initialize(Map& map, Frame& first, Frame& second,
+                                                         const Rigid3& world_from_first,
+                                                         const Rigid3& world_from_second,
+                                                         std::size_t frame_index) const {
+  MarkerInitializationResult result;
+  result.baseline_m = (world_from_first.translation - world_from_second.translation).norm();
+  if (result.baseline_m < options_.min_baseline_m) {
+    result.status = MarkerInitializationStatus::kShortBaseline;
+    result.message = "waiting for a marker baseline";  // marker poses are output meanwhile
+    return result;
   }
-  const Rigid3& world_from_cam1 = init_reference_fix_->world_from_cam;
-  const Rigid3& world_from_cam2 = fix->world_from_cam;
-  const double baseline = (world_from_cam1.translation - world_from_cam2.translation).norm();
-  if (baseline < options_.min_marker_init_baseline_m) {
-    report.message = "waiting for a marker baseline";  // marker poses are output meanwhile
-    return true;
-  }
-  Frame first = *init_reference_;
   const InitializationResult triangulated =
-      TriangulateWithKnownMotion(first, frame, world_from_cam2.Inverse() * world_from_cam1,
-                                 options_.initializer, options_.min_marker_init_parallax_deg);
-  ARUCOSLAM_LOG_DEBUG("frame {}: marker initialisation: {}", report.index, triangulated.message);
-  if (!triangulated.success) return false;
-  const InitialMapResult created =
-      CreateInitialMap(*map_, first, frame, triangulated, options_.initial_map);
-  if (!created.success) {
-    report.message = created.message;
-    return false;
+      TriangulateWithKnownMotion(first, second, world_from_second.Inverse() * world_from_first,
+                                 two_view_, options_.min_parallax_deg);
+  ARUCOSLAM_LOG_DEBUG("frame {}: marker initialisation: {}", frame_index, triangulated.message);
+  result.message = triangulated.message;
+  if (!triangulated.success) return result;
+  result.map = CreateInitialMap(map, first, second, triangulated, initial_map_);
+  if (!result.map.success) {
+    result.message = result.map.message;
+    return result;
   }
   // Both marker poses against both keyframes: rotation averaged from the two orientations,
   // scale from the baselines, translation from the centres.
   std::vector<WorldAnchor> anchors(2);
-  anchors[0].keyframe = created.first;
+  anchors[0].keyframe = result.map.first;
   anchors[0].cam_from_map = *first.cam_from_world;
-  anchors[0].world_from_cam = world_from_cam1;
-  anchors[1].keyframe = created.second;
-  anchors[1].cam_from_map = *frame.cam_from_world;
-  anchors[1].world_from_cam = world_from_cam2;
-  const WorldAlignment alignment =
-      EstimateWorldFromMap(anchors, options_.world_anchoring.alignment);
+  anchors[0].world_from_cam = world_from_first;
+  anchors[1].keyframe = result.map.second;
+  anchors[1].cam_from_map = *second.cam_from_world;
+  anchors[1].world_from_cam = world_from_second;
+  const WorldAlignment alignment = EstimateWorldFromMap(anchors, options_.alignment);
   if (!alignment.success) {
     // The map stays (unaligned); world alignment waits for more anchors as usual.
-    ARUCOSLAM_LOG_DEBUG("frame {}: marker initialisation not aligned: {}", report.index,
+    ARUCOSLAM_LOG_DEBUG("frame {}: marker initialisation not aligned: {}", frame_index,
                         alignment.failure);
-    FinishInitialization(first, frame, created.first, created.second, created.num_points, report);
-    return true;
+    result.status = MarkerInitializationStatus::kUnaligned;
+    result.message = alignment.failure;
+    return result;
   }
   const Sim3& world_from_map = alignment.world_from_map;
-  map_->Write([&](MapData& data) { ApplyWorldAlignment(world_from_map, &data); });
+  map.Write([&](MapData& data) { ApplyWorldAlignment(world_from_map, &data); });
   const auto to_world = [&](const Rigid3& cam_from_map) {
     return world_from_map.TransformPose(cam_from_map.Inverse()).Inverse();
   };
   first.cam_from_world = to_world(*first.cam_from_world);
-  frame.cam_from_world = to_world(*frame.cam_from_world);
-  anchoring_.AlignedFromMarkers();  // re-aligned as anchors come
-  marker_fusion_.MapEnteredWorld(frame.timestamp_s);
-  RefreshKeyframePoseCache();
-  {
-    std::lock_guard lock(stats_mutex_);
-    ++stats_.num_marker_initializations;
-  }
-  ARUCOSLAM_LOG_DEBUG("frame {}: map initialised from markers in the world, baseline {:.2f} m, "
-                      "scale {:.3f}", report.index, baseline, world_from_map.scale);
-  FinishInitialization(first, frame, created.first, created.second, created.num_points, report);
-  report.message += " (from markers, in the world)";
-  return true;
+  second.cam_from_world = to_world(*second.cam_from_world);
+  result.status = MarkerInitializationStatus::kInWorld;
+  result.world_from_map = world_from_map;
+  ARUCOSLAM_LOG_DEBUG(
+      "frame {}: map initialised from markers in the world, baseline {:.2f} m, "
+      "scale {:.3f}",
+      frame_index, result.baseline_m, world_from_map.scale);
+  return result;
 }
 
 }  // namespace arucoslam
