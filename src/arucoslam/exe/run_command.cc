@@ -94,7 +94,9 @@ class StopOnInterrupt {
   void (*previous_)(int);
 };
 
-std::unique_ptr<FrameSource> OpenSource(const RunArgs& args) {
+// A recording is replayed at its own rate in threaded mode (frames late but none dropped; with
+// --realtime the late ones are dropped, as by a live camera) and as fast as read when blocking.
+std::unique_ptr<FrameSource> OpenSource(const RunArgs& args, bool blocking) {
   if (args.dataset.empty() == args.device.empty()) {
     throw InputError("--dataset", "give either --dataset PATH or --device CAMERA");
   }
@@ -113,9 +115,10 @@ std::unique_ptr<FrameSource> OpenSource(const RunArgs& args) {
       dataset_options.rate_hz = args.rate_hz;
       recorded = OpenFrameSource(args.dataset, dataset_options);
     }
-    if (!args.realtime) return recorded;
+    if (blocking && !args.realtime) return recorded;
     PacedSourceOptions paced;
     paced.stop = &g_stop_requested;
+    paced.drop_late = args.realtime;
     return std::make_unique<PacedSource>(std::move(recorded), paced);
   }
   if (args.camera.empty()) {
@@ -170,7 +173,7 @@ int RunSlam(const RunArgs& args) {
     throw InputError(args.out, "exists and is not a directory");
   }
   const StopOnInterrupt stop_on_interrupt;
-  const std::unique_ptr<FrameSource> source = OpenSource(args);
+  const std::unique_ptr<FrameSource> source = OpenSource(args, options.blocking);
   std::optional<std::filesystem::path> markers_path = source->markers_path();
   if (!args.markers.empty()) markers_path = args.markers;
   if (args.no_markers) markers_path.reset();
@@ -227,7 +230,8 @@ void AddRunCommand(CLI::App& app, int& exit_status) {
   device->excludes(dataset);
   run->add_flag("--realtime", args->realtime,
                 "replay --dataset at its recorded rate, as the camera delivered it: frames the "
-                "SLAM has no time for are dropped (stats.json frames.dropped), as with --device")
+                "SLAM has no time for are dropped (stats.json frames.dropped), as with --device "
+                "(threaded runs without it hand such frames over late)")
       ->excludes(device);
   run->add_option("--image-topic", args->image_topic,
                   "ROS bag: the image topic (sensor_msgs/Image or CompressedImage)");
@@ -273,7 +277,9 @@ void AddRunCommand(CLI::App& app, int& exit_status) {
                       "marker); overrides the config file")
           ->capture_default_str();
   run->add_flag("--blocking", args->blocking,
-                "track and map each frame in turn on one thread (deterministic)");
+                "track and map each frame in turn on one thread (deterministic), as fast as the "
+                "machine goes; without it a recording is replayed at its own rate, mapping on "
+                "its own thread");
   run->add_flag("--quiet", args->quiet, "no progress line");
   args->num_features = defaults.extractor.num_features;
   CLI::Option* features = run->add_option("--features", args->num_features,

@@ -56,7 +56,11 @@ void PacedSource::Replay() {
         }
       }
       if (stopping()) break;
-      if (!queue_->frames.TryPush(std::move(*frame))) ++dropped_;
+      if (!options_.drop_late) {
+        if (!queue_->frames.Push(std::move(*frame))) break;  // closed: the source is going
+      } else if (!queue_->frames.TryPush(std::move(*frame))) {
+        ++dropped_;
+      }
     }
   } catch (...) {
     std::lock_guard lock(error_mutex_);

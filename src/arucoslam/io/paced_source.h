@@ -1,5 +1,6 @@
 // PacedSource: replays a recorded source (dataset, video, bag) at the rate its timestamps give,
-// as a live camera would deliver it; frames the consumer has no room for when due are dropped.
+// as a live camera would deliver it; frames the consumer has no room for when due are dropped
+// (or, without drop_late, handed over late).
 #pragma once
 
 #include <atomic>
@@ -22,6 +23,10 @@ struct PacedSourceOptions {
   std::size_t queue_capacity = 2;
   // Replay speed: 1 plays the recording in its own time, 2 twice as fast.
   double speed = 1.0;
+  // true: a frame due while queue_capacity frames wait is dropped, as by a live camera.
+  // false: it waits for room, and the frames after it are handed over as soon as they are due
+  // (the recording's rate is then an upper bound; nothing is dropped).
+  bool drop_late = true;
   // Replay ends once this flag is set (e.g. by a SIGINT handler); may be null.
   const std::atomic<bool>* stop = nullptr;
 

@@ -93,6 +93,35 @@ TEST(PacedSourceTest, ASlowConsumerLosesFramesAndEveryFrameIsCounted) {
   EXPECT_GE(source.frames_dropped(), 20u);
 }
 
+TEST(PacedSourceTest, WithoutDropsASlowConsumerGetsEveryFrameLate) {
+  PacedSourceOptions options;
+  options.drop_late = false;
+  PacedSource source(std::make_unique<Recording>(20, 0.005), options);  // 0.1 s of recording
+  const Clock::time_point start = Clock::now();
+  std::vector<std::size_t> images;
+  while (std::optional<SourceFrame> frame = source.Next()) {
+    images.push_back(frame->image.at<std::uint8_t>(0, 0));
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));  // 4 frame intervals
+  }
+  EXPECT_EQ(source.frames_dropped(), 0u);
+  ASSERT_EQ(images.size(), 20u);
+  for (std::size_t i = 0; i < images.size(); ++i) EXPECT_EQ(images[i], i);
+  // The consumer's own pace, 20 x 20 ms, not the recording's 0.1 s.
+  EXPECT_GE(std::chrono::duration<double>(Clock::now() - start).count(), 0.4);
+}
+
+TEST(PacedSourceTest, WithoutDropsTheDestructorStopsAReplayWaitingForRoom) {
+  const Clock::time_point start = Clock::now();
+  {
+    PacedSourceOptions options;
+    options.drop_late = false;
+    PacedSource source(std::make_unique<Recording>(1000, 0.0001), options);
+    ASSERT_TRUE(source.Next());  // the replay then fills the queue and waits for room
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  EXPECT_LT(std::chrono::duration<double>(Clock::now() - start).count(), 5.0);
+}
+
 TEST(PacedSourceTest, StopFlagEndsTheReplay) {
   std::atomic<bool> stop{false};
   PacedSourceOptions options;

@@ -44,10 +44,6 @@ void VisitOptions(SystemOptions& o, Visitor& visit) {
         "keyframes waiting for the mapping thread");
   visit("yield_bundle_adjustment", o.yield_bundle_adjustment,
         "threaded: a local BA ends early once another keyframe waits");
-  visit("synchronous_young_map_keyframes", o.synchronous_young_map_keyframes,
-        "threaded: tracking waits for mapping while the map has at most this many keyframes");
-  visit("synchronous_until_aligned", o.synchronous_until_aligned,
-        "threaded, marker map: ... and while the map is not aligned to the marker world");
   visit("max_initialization_gap_s", o.max_initialization_gap_s,
         "the initialisation reference is replaced after this long, seconds");
   visit("map_session", o.map_session,

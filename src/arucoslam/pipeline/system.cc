@@ -56,20 +56,11 @@ System::~System() { Finish(); }
 void System::StartMappingThread() {
   if (options_.blocking) return;
   queue_ = std::make_unique<BoundedQueue<KeyframeId>>(options_.mapper_queue_capacity);
-  keyframes_queued_ = 0;
-  {
-    std::lock_guard lock(mapped_mutex_);
-    keyframes_mapped_ = 0;
-  }
+  keyframes_in_mapping_ = 0;
   mapping_thread_ = std::thread([this] {
     while (const std::optional<KeyframeId> keyframe = queue_->Pop()) {
       MapKeyframe(*keyframe);
-      mapping_busy_ = false;
-      {
-        std::lock_guard lock(mapped_mutex_);
-        ++keyframes_mapped_;
-      }
-      mapped_.notify_all();
+      --keyframes_in_mapping_;
     }
   });
 }
@@ -105,11 +96,6 @@ void System::Finish() {
   stats_.num_unposed_without_markers = unposed_without_markers;
 }
 
-void System::WaitForMapping() {
-  std::unique_lock lock(mapped_mutex_);
-  mapped_.wait(lock, [this] { return keyframes_mapped_ >= keyframes_queued_; });
-}
-
 void System::MakeLocalMapper() {
   mapper_ = std::make_unique<LocalMapper>(*map_, options_.mapper);
   GuardMarkerKeyframes();
@@ -121,7 +107,7 @@ void System::MakeLocalMapper() {
 
 bool System::MapperIdle() const {
   if (options_.blocking) return true;
-  return !mapping_busy_ && queue_->Size() == 0;
+  return keyframes_in_mapping_ == 0;
 }
 
 void System::MapKeyframe(KeyframeId keyframe) {
@@ -373,6 +359,8 @@ void System::MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& rep
   });
   input.mapper_idle = MapperIdle();
   input.mapper_has_room = options_.blocking || queue_->Size() < queue_->capacity();
+  input.num_map_keyframes = static_cast<int>(map_->NumKeyframes());
+  if (!MayInsertKeyframe(options_.keyframes, input)) return;
   // A frame with a usable marker location becomes a keyframe sooner until the map is first
   // aligned (anchors are kept on keyframes only).
   const bool wants_anchor =
@@ -398,17 +386,8 @@ void System::MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& rep
   if (options_.blocking) {
     pending_keyframe_ = keyframe;  // mapped once the frame's tracking time is recorded
   } else {
-    mapping_busy_ = true;
-    if (queue_->Push(keyframe)) {
-      ++keyframes_queued_;
-      const bool young =
-          static_cast<int>(map_->NumKeyframes()) <= options_.synchronous_young_map_keyframes;
-      const bool unaligned =
-          options_.marker_map && !anchoring_.aligned() && options_.synchronous_until_aligned;
-      if (young || unaligned) {
-        WaitForMapping();
-      }
-    }
+    ++keyframes_in_mapping_;
+    if (!queue_->Push(keyframe)) --keyframes_in_mapping_;
   }
   MaybeAlignWorld(frame);
 }

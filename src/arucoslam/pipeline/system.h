@@ -7,7 +7,6 @@
 #include <opencv2/core.hpp>
 
 #include <atomic>
-#include <condition_variable>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -276,15 +275,8 @@ class System {
 
   std::unique_ptr<BoundedQueue<KeyframeId>> queue_;
   std::thread mapping_thread_;
-  std::atomic<bool> mapping_busy_{false};
-  // Threaded mode: keyframes pushed to queue_ and keyframes the mapping thread finished,
-  // both counted from StartMappingThread (synchronous_young_map_keyframes).
-  std::size_t keyframes_queued_ = 0;
-  std::size_t keyframes_mapped_ = 0;  // guarded by mapped_mutex_
-  std::mutex mapped_mutex_;
-  std::condition_variable mapped_;
-  // Waits until the mapping thread has mapped every keyframe queued so far.
-  void WaitForMapping();
+  // Threaded mode: keyframes queued or being mapped (MapperIdle), from StartMappingThread.
+  std::atomic<int> keyframes_in_mapping_{0};
   bool finished_ = false;
 
   mutable std::mutex stats_mutex_;

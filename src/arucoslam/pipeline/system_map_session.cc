@@ -70,7 +70,6 @@ void System::ResetMap() {
   anchoring_.Reset();
   marker_fusion_.MapReset();
   last_state_ = TrackingState::kNotInitialized;
-  mapping_busy_ = false;
   StartMappingThread();
 }
 

@@ -70,7 +70,6 @@ void System::MaybeAlignWorld(Frame& frame) {
     // re-alignment from this map's anchors alone would tear them apart. Markers correct the
     // map by fusion from here on (drift correction, marker corners in bundle adjustment).
     anchoring_.StopRealigning();
-    mapping_busy_ = false;
     StartMappingThread();
     ARUCOSLAM_LOG_DEBUG("world re-alignment stopped: the merged map is linked to this one");
     return;
@@ -101,7 +100,6 @@ void System::MaybeAlignWorld(Frame& frame) {
   }
   if (frame.cam_from_world) frame.cam_from_world = to_world(*frame.cam_from_world);
   if (MergeClosedMap()) CorrectAcrossBridge();
-  mapping_busy_ = false;
   StartMappingThread();
   ARUCOSLAM_LOG_DEBUG("keypoint map {}aligned to the marker world: scale {:.4f}, {} of {} "
                       "anchors, rms {:.3f} m",

@@ -170,41 +170,6 @@ TEST(SystemMarkers, ThreadedRunIsInTheWorldFrame) {
   EXPECT_NEAR(AlignmentScale(run.trajectory), 1.0, 0.01);
 }
 
-TEST(SystemMarkers, ThreadedRunMapsEachKeyframeBeforeTheNextFrameUntilAligned) {
-  // synchronous_until_aligned: no marker before frame 60, so the map stays unaligned that
-  // long and tracking waits for each of its keyframes' local mapping (the young-map rule is
-  // off here): when ProcessFrame returns, every keyframe it inserted is mapped.
-  const CameraModel camera = SceneCamera();
-  SyntheticFeatureScene scene(camera);
-  SystemOptions options;
-  options.blocking = false;
-  options.synchronous_young_map_keyframes = 0;
-  options.synchronous_until_aligned = true;  // off by default
-  options.marker_map = SceneMarkers();
-  System system(camera, options);
-  std::mt19937 rng(7);
-  std::vector<int> truth;
-  int checked = 0;
-  bool aligned = false;
-  for (int t = 0; t < 100; ++t) {
-    const Rigid3 cam_from_world = SceneWorldFromCam(t).Inverse();
-    Frame frame = scene.MakeFrame(FrameId(t), kSceneDt * t, cam_from_world, &truth);
-    std::vector<MarkerDetection> detections;
-    if (t >= 60) detections = SceneDetections(SceneMarkers(), camera, cam_from_world, rng);
-    const FrameReport report = system.ProcessFrame(std::move(frame), detections);
-    aligned = aligned || report.world_aligned;
-    if (aligned || !report.new_keyframe || report.initialized_map) continue;
-    const SystemStats stats = system.Stats();
-    EXPECT_EQ(static_cast<int>(stats.local_mapping_ms.Count()),
-              stats.num_keyframes_inserted - 2 * stats.num_initializations)
-        << "frame " << t;
-    ++checked;
-  }
-  EXPECT_GE(checked, 5);  // keyframes were inserted before the alignment
-  EXPECT_TRUE(aligned);
-  system.Finish();
-}
-
 TEST(SystemMarkers, FirstMarkerAfterBlackoutGivesAccuratePose) {
   // A 2 s blackout (40 frames) after the map is aligned.
   const MarkerRun run = RunWithMarkers(true, 110, 50, 90);
@@ -400,11 +365,12 @@ TEST(SystemMarkers, DriftThatTheMarkersRevealAfterAGapIsCorrectedNotRejected) {
 }
 
 TEST(SystemMarkers, ThreadedDriftCorrectionSeesTheKeyframesMarkers) {
-  // Threaded, each keyframe mapped before the next frame: the mapping thread corrects the
-  // drift only if the keyframe's marker location was stored before the keyframe was queued.
+  // Threaded, each keyframe inserted once the previous one is mapped: the mapping thread
+  // corrects the drift only if the keyframe's marker location was stored before the keyframe
+  // was queued.
   const DriftRun run = RunWithShiftedMarkers(ShiftAfterGap, [](SystemOptions* options) {
     options->blocking = false;
-    options->synchronous_young_map_keyframes = 1000;
+    options->keyframes.young_map_keyframes = 1000;
   });
   EXPECT_EQ(run.stats.marker_fusion.num_drift_disagreements, 1);
   EXPECT_EQ(run.stats.marker_fusion.num_rejected_poses, 0);

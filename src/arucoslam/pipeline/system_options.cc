@@ -16,7 +16,6 @@ bool SystemOptions::Check(std::string* why) const {
   check.Above("max_initialization_gap_s", max_initialization_gap_s, 0.0);
   check.Nested("map_session", map_session);
   check.Nested("pose_consistency", pose_consistency);
-  check.AtLeast("synchronous_young_map_keyframes", synchronous_young_map_keyframes, 0);
   check.Nested("detector", detector);
   check.Nested("marker_fusion", marker_fusion);
   check.Nested("world_anchoring", world_anchoring);

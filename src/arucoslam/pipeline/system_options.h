@@ -46,13 +46,6 @@ struct SystemOptions {
   // its points mapped without waiting for the BAs of the keyframes before it (ORB-SLAM's
   // abort). Blocking mode: no keyframe waits.
   bool yield_bundle_adjustment = true;
-  // Threaded mode: while the map holds at most this many keyframes, tracking waits until
-  // each new keyframe is mapped before it takes the next frame, as in blocking mode: a young
-  // map tracked ahead of its local BA drifts in scale. 0: tracking never waits.
-  int synchronous_young_map_keyframes = 20;
-  // With a marker map: tracking also waits for every keyframe of a map not yet aligned to the
-  // marker world. Off by default: a live camera would lose the frames of every such wait.
-  bool synchronous_until_aligned = false;
   // The initialisation reference frame is replaced when the current frame is more than this
   // many seconds later (a reference is also replaced when too few matches are left). Long
   // enough for a vehicle that starts from rest to build up parallax.

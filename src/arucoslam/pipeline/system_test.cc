@@ -243,14 +243,19 @@ TEST(System, ThreadedRunTracksSyntheticSequence) {
   EXPECT_LT(AlignedRmsError(run.trajectory), 0.024);
 }
 
-TEST(System, ThreadedRunMapsAYoungMapsKeyframesBeforeTheNextFrame) {
-  // While the map holds at most synchronous_young_map_keyframes keyframes, tracking waits
-  // for each new keyframe's local mapping: when ProcessFrame returns, every keyframe it
-  // inserted is mapped (the two of the initial map are not mapped by local mapping).
+TEST(System, ThreadedYoungMapTakesAKeyframeOnlyOnceThePreviousIsMapped) {
+  // While the map holds at most keyframes.young_map_keyframes keyframes, a keyframe is
+  // inserted only when the mapper is idle: every keyframe inserted before it has been mapped
+  // (the two of the initial map are not mapped by local mapping). Tracking never waits.
   SyntheticFeatureScene scene(TestCamera());
   SystemOptions options;
   options.blocking = false;
-  options.synchronous_young_map_keyframes = 1000;
+  options.keyframes.young_map_keyframes = 1000;
+  // Every frame wants to be a keyframe: without the rule they would queue up.
+  options.keyframes.min_frames_between = 1;
+  options.keyframes.max_frames_between = 1;
+  options.keyframes.weak_min_frames_between = 1;
+  options.keyframes.tracked_ratio = 1.0;
   System system(TestCamera(), options);
   std::vector<int> truth;
   int checked = 0;
@@ -259,12 +264,13 @@ TEST(System, ThreadedRunMapsAYoungMapsKeyframesBeforeTheNextFrame) {
         scene.MakeFrame(FrameId(t), 0.05 * t, WorldFromCam(t).Inverse(), &truth));
     const SystemStats stats = system.Stats();
     if (!report.new_keyframe || report.initialized_map) continue;
-    EXPECT_EQ(static_cast<int>(stats.local_mapping_ms.Count()),
-              stats.num_keyframes_inserted - 2 * stats.num_initializations)
+    // Mapped by now: at least every keyframe before this frame's.
+    EXPECT_GE(static_cast<int>(stats.local_mapping_ms.Count()),
+              stats.num_keyframes_inserted - 1 - 2 * stats.num_initializations)
         << "frame " << t;
     ++checked;
   }
-  EXPECT_GE(checked, 5);  // keyframes were inserted after the initial map
+  EXPECT_GE(checked, 3);  // keyframes were inserted after the initial map
   system.Finish();
   EXPECT_LT(AlignedRmsError(system.Trajectory()), 0.024);
 }

@@ -15,12 +15,14 @@ bool KeyframePolicyOptions::Check(std::string* why) const {
   check.AtMost("weak_ratio", weak_ratio, tracked_ratio, "tracked_ratio");
   check.AtLeast("weak_tracked_points", weak_tracked_points, 0);
   check.AtLeast("weak_min_frames_between", weak_min_frames_between, 1);
+  check.AtLeast("young_map_keyframes", young_map_keyframes, 0);
   return check.ok();
 }
 
 KeyframeDecision DecideKeyframe(const KeyframePolicyOptions& options,
                                 const KeyframeDecisionInput& input) {
   if (input.num_tracked <= options.min_tracked_points) return {false, "too-few"};
+  if (!MayInsertKeyframe(options, input)) return {false, "young-busy"};
   const bool ratio_low =
       input.num_tracked < options.tracked_ratio * input.num_reference_tracked;
   if (!ratio_low) return {false, "ratio-high"};
@@ -35,6 +37,10 @@ KeyframeDecision DecideKeyframe(const KeyframePolicyOptions& options,
   }
   if (waited_long && input.mapper_has_room) return {true, "max-frames"};
   return {false, input.mapper_idle ? "too-soon" : "busy"};
+}
+
+bool MayInsertKeyframe(const KeyframePolicyOptions& options, const KeyframeDecisionInput& input) {
+  return input.mapper_idle || input.num_map_keyframes > options.young_map_keyframes;
 }
 
 int ReferenceTrackedPoints(const MapData& data, KeyframeId keyframe, int min_observations) {

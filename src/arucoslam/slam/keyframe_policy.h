@@ -34,6 +34,11 @@ struct KeyframePolicyOptions {
   // keyframe: local BA's window (20 keyframes) then spanned 0.7 s of the turn, its fixed
   // keyframes too, and the scale drifted with the turn's low-parallax points.
   int weak_min_frames_between = 3;
+  // While the map holds at most this many keyframes, no keyframe (of any kind) is inserted
+  // while the mapper is busy: each new keyframe of a young map is tracked against a map whose
+  // previous keyframe has been locally adjusted, so tracking need not wait for mapping.
+  // 0: no such rule.
+  int young_map_keyframes = 20;
 
   bool Check(std::string* why = nullptr) const;
 };
@@ -45,6 +50,7 @@ struct KeyframeDecisionInput {
   int num_reference_tracked = 0;  // ReferenceTrackedPoints() of its reference keyframe
   bool mapper_idle = true;        // nothing queued and nothing being processed
   bool mapper_has_room = true;    // the mapper's queue can take one more keyframe
+  int num_map_keyframes = 0;      // keyframes in the map now
 };
 
 struct KeyframeDecision {
@@ -54,6 +60,10 @@ struct KeyframeDecision {
 
 KeyframeDecision DecideKeyframe(const KeyframePolicyOptions& options,
                                 const KeyframeDecisionInput& input);
+
+// False while a young map's mapper is busy (young_map_keyframes): then no keyframe at all,
+// not even one the caller wants for other reasons (a marker anchor).
+bool MayInsertKeyframe(const KeyframePolicyOptions& options, const KeyframeDecisionInput& input);
 
 // Points of `keyframe` observed by at least `min_observations` keyframes (0 when unknown).
 int ReferenceTrackedPoints(const MapData& data, KeyframeId keyframe, int min_observations);

@@ -14,6 +14,7 @@ KeyframeDecisionInput Input(int since, int tracked, int reference, bool idle, bo
   input.num_reference_tracked = reference;
   input.mapper_idle = idle;
   input.mapper_has_room = room;
+  input.num_map_keyframes = 100;  // past the young-map rule
   return input;
 }
 
@@ -84,6 +85,27 @@ TEST(KeyframePolicy, WeakKeyframesAreSpaced) {
   EXPECT_EQ(DecideKeyframe(options, Input(3, 99, 400, true)).reason, "weak");
   EXPECT_EQ(DecideKeyframe(options, Input(2, 99, 400, false)).reason, "busy");
   options.weak_min_frames_between = 0;
+  EXPECT_FALSE(options.Check());
+}
+
+TEST(KeyframePolicy, AYoungMapTakesNoKeyframeWhileTheMapperIsBusy) {
+  KeyframePolicyOptions options;
+  options.young_map_keyframes = 20;
+  KeyframeDecisionInput weak = Input(5, 50, 400, false);  // weak tracking, room in the queue
+  weak.num_map_keyframes = 20;
+  EXPECT_FALSE(MayInsertKeyframe(options, weak));
+  EXPECT_EQ(DecideKeyframe(options, weak).reason, "young-busy");
+  weak.num_map_keyframes = 21;  // no longer young: a weak frame goes to the busy mapper's queue
+  EXPECT_TRUE(MayInsertKeyframe(options, weak));
+  EXPECT_EQ(DecideKeyframe(options, weak).reason, "weak");
+  KeyframeDecisionInput idle = Input(5, 150, 200, true);
+  idle.num_map_keyframes = 3;  // young but idle: the usual rules
+  EXPECT_TRUE(MayInsertKeyframe(options, idle));
+  EXPECT_EQ(DecideKeyframe(options, idle).reason, "ratio");
+  options.young_map_keyframes = 0;  // no young-map rule
+  weak.num_map_keyframes = 2;
+  EXPECT_EQ(DecideKeyframe(options, weak).reason, "weak");
+  options.young_map_keyframes = -1;
   EXPECT_FALSE(options.Check());
 }
 

@@ -111,6 +111,8 @@ void VisitOptions(KeyframePolicyOptions& o, Visitor& visit) {
   visit("weak_ratio", o.weak_ratio, "weak tracking: fewer than this x the reference's points");
   visit("weak_tracked_points", o.weak_tracked_points, "... or fewer inliers than this");
   visit("weak_min_frames_between", o.weak_min_frames_between, "frames between two weak keyframes");
+  visit("young_map_keyframes", o.young_map_keyframes,
+        "while the map has at most this many keyframes, none is inserted while the mapper is busy");
 }
 
 template <class Visitor>
