@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # ThreadSanitizer build of the threaded tests (the System in threaded mode, local mapping and
-# loop closing on their threads, the marker detector and ORB thread pools, the real-time replay)
+# loop closing on their threads, the marker detector, its front-end and the ORB thread pools, the marker mapping published across threads, the real-time replay)
 # run clean, or fail.
 # Usage: scripts/tsan-tests.sh [BUILD_DIR]   (default build-tsan; `make tsan` calls it)
 set -euo pipefail
@@ -14,6 +14,8 @@ tests=(
   "src/arucoslam/pipeline/test_pipeline_system_markers_test|*Threaded*"
   "src/arucoslam/pipeline/test_pipeline_system_recovery_test|*Threaded*"
   "src/arucoslam/pipeline/test_pipeline_marker_detector_worker_test|*"
+  "src/arucoslam/pipeline/test_pipeline_marker_frontend_test|*"
+  "src/arucoslam/slam/test_slam_online_marker_mapping_test|*"
   "src/arucoslam/util/test_util_thread_pool_test|*"
   "src/arucoslam/feature/test_feature_orb_extractor_test|*ThreadCount*"
   "src/arucoslam/map/test_map_map_test|*Concurrent*"
