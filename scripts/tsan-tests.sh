@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # ThreadSanitizer build of the threaded tests (the System in threaded mode, local mapping and
-# loop closing on their threads, the marker detector, its front-end and the ORB thread pools, the marker mapping published across threads, the real-time replay)
-# run clean, or fail.
+# loop closing on their threads, the marker detector, its front-end and the ORB thread pools,
+# the marker mapping published across threads, the real-time replay) run clean, or fail.
 # Usage: scripts/tsan-tests.sh [BUILD_DIR]   (default build-tsan; `make tsan` calls it)
 set -euo pipefail
 cd "$(dirname "$0")/.."
