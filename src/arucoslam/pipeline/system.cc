@@ -293,7 +293,8 @@ void System::FinishInitialization(const InitialMap& initial, Frame& frame, Frame
   const KeyframeId second_id = initial.second_id;
   tracker_->Start(frame, second_id);
   // The reference frame may have got a marker-only pose when it was seen: replaced in place.
-  pose_history_.Record(*map_, first, first_id, anchoring_.aligned(), marker_fusion_.fix(),
+  // Its own marker location goes with it, not the current frame's.
+  pose_history_.Record(*map_, first, first_id, anchoring_.aligned(), initial.first_fix,
                        /*in_place=*/true);
   RecordPose(frame, second_id);
   BackfillInitialization(frame, first_id, second_id);
