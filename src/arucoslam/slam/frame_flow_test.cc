@@ -2,7 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <random>
 #include <string>
@@ -41,13 +46,51 @@ class InlineMapping final : public MappingControl {
   int num_resumes = 0;
 };
 
-// A FrameFlow without places, fed frames of the synthetic scene; with `markers` it knows the
+// A place database that offers the pose it is given (none: nothing found) and counts what
+// the flow does with it.
+class ScriptedPlaces final : public PlaceIndex {
+ public:
+  std::optional<RelocalizationResult> Relocalize(const Frame&) override {
+    ++num_queries;
+    return offer;
+  }
+  void RelocalizationTaken() override { ++num_taken; }
+  void IndexExistingKeyframes() override {}
+  void IndexKeyframes(const std::vector<KeyframeId>&) override {}
+  void KeyframeMapped(KeyframeId) override { ++num_mapped; }
+  std::unique_lock<std::mutex> LockMapEdits() override { return std::unique_lock(mutex_); }
+  void MapMovedExternally() override {}
+  void SetMetricMap(bool) override {}
+  void SetMarkerLandmarks(MarkerLandmarks*) override {}
+  void SetBundleAdjustmentPriors(std::vector<KeyframePosePrior>) override {}
+  void SetLoopPosePriors(LoopCloser::PosePriorSource, const EssentialGraphOptions&) override {}
+  std::uint64_t corrections() const override { return 0; }
+  double KeyframeScale(KeyframeId) const override { return 1.0; }
+  void RecordScaleChanges(const std::map<KeyframeId, double>&) override {}
+  void Finish() override {}
+
+  std::optional<RelocalizationResult> offer;
+  int num_queries = 0;
+  int num_taken = 0;
+  int num_mapped = 0;
+
+ private:
+  std::mutex mutex_;
+};
+
+// A FrameFlow, without places unless given, fed frames of the synthetic scene; with `markers` it knows the
 // scene's wall of markers and locates each frame from their detections first.
 class FlowHarness {
  public:
   explicit FlowHarness(bool markers) : FlowHarness(markers, Options(markers)) {}
-  FlowHarness(bool markers, const FrameFlowOptions& options)
-      : flow_(SceneCamera(), options, &mapping_, [](Map&) { return nullptr; }, &stats_, &mutex_),
+  // `places` serves the first map only.
+  FlowHarness(bool markers, const FrameFlowOptions& options,
+              std::unique_ptr<PlaceIndex> places = nullptr)
+      : flow_(SceneCamera(), options, &mapping_,
+              [held = std::make_shared<std::unique_ptr<PlaceIndex>>(std::move(places))](Map&) {
+                return std::move(*held);
+              },
+              &stats_, &mutex_),
         markers_(markers) {}
 
   static FrameFlowOptions Options(bool markers) {
@@ -57,9 +100,10 @@ class FlowHarness {
     return options;
   }
 
-  // Frame at route position t, with its keypoints (and markers) unless `blank`.
-  FrameReport Step(int t, bool blank = false) {
-    const Rigid3 cam_from_world = SceneWorldFromCam(t).Inverse();
+  // Frame at time t and route position t - route_shift, with its keypoints (and markers)
+  // unless `blank`.
+  FrameReport Step(int t, bool blank = false, int route_shift = 0) {
+    const Rigid3 cam_from_world = SceneWorldFromCam(t - route_shift).Inverse();
     Frame frame = scene_.MakeFrame(FrameId(index_), kSceneDt * t, cam_from_world, &truth_);
     std::vector<MarkerDetection> detections;
     if (markers_ && !blank) {
@@ -240,6 +284,71 @@ TEST(FrameFlow, ALongLossStartsANewMapThatInitialisesAgain) {
   EXPECT_LE(reinitialised, 80);
   EXPECT_EQ(harness.stats().num_initializations, 2);
   EXPECT_EQ(harness.stats().num_losses, 1);
+}
+
+TEST(FrameFlow, APlacePoseIsTakenOnlyWhenTheLocalMapConfirmsIt) {
+  // Without the reference-keyframe fallback the frame after the initialisation (no motion
+  // known yet) is lost, and only the place database can give its pose back.
+  FrameFlowOptions options = FlowHarness::Options(/*markers=*/false);
+  options.tracker.min_reference_matches = 1000000;
+  options.map_session.reset_max_keyframes = 0;  // the young map is kept while lost
+  auto owned = std::make_unique<ScriptedPlaces>();
+  ScriptedPlaces* places = owned.get();
+  FlowHarness harness(/*markers=*/false, options, std::move(owned));
+  int t = 0;
+  FrameReport initialised;
+  for (; t < 10 && !initialised.initialized_map; ++t) initialised = harness.Step(t);
+  ASSERT_TRUE(initialised.initialized_map);
+  ASSERT_TRUE(initialised.cam_from_world);
+  EXPECT_EQ(places->num_mapped, 2);  // both initial keyframes
+  const int t_second = t - 1;
+  const Rigid3 second_pose = *initialised.cam_from_world;
+  const std::vector<StampedPose> keyframes = harness.flow().KeyframePoses();
+  ASSERT_EQ(keyframes.size(), 2u);
+  const int t_first = test_scene::SceneFrameOf(keyframes.front().timestamp_s);
+  const Eigen::Vector3d first_centre = keyframes.front().world_from_cam.translation;
+  const Eigen::Vector3d second_centre = second_pose.Inverse().translation;
+  const double baseline = (second_centre - first_centre).norm();
+
+  // The second keyframe's pose moved sideways by ten baselines: refined against the local
+  // map it finds no support and is refused; the map is kept.
+  RelocalizationResult far;
+  far.cam_from_world =
+      Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(10.0 * baseline, 0.0, 0.0)) *
+      second_pose;
+  far.keyframe = harness.flow().map().Read(
+      [](const MapData& data) { return data.keyframes().rbegin()->first; });
+  places->offer = far;
+  const FrameReport refused = harness.Step(t++);
+  EXPECT_EQ(refused.state, TrackingState::kLost);
+  EXPECT_EQ(refused.message, "tracking lost");
+  EXPECT_EQ(places->num_queries, 1);
+  EXPECT_EQ(places->num_taken, 0);
+  EXPECT_EQ(harness.flow().map().NumKeyframes(), 2u);
+
+  // The second keyframe's pose as it is, two frames behind the camera: refined and taken.
+  RelocalizationResult near = far;
+  near.cam_from_world = second_pose;
+  places->offer = near;
+  const int t_taken = t;
+  const FrameReport taken = harness.Step(t++);
+  EXPECT_EQ(taken.state, TrackingState::kTracking);
+  EXPECT_EQ(taken.message, "relocalised from the place database");
+  EXPECT_EQ(places->num_taken, 1);
+  ASSERT_TRUE(taken.cam_from_world);
+  // The refined pose moved on from the second keyframe as the camera did: the step relative
+  // to the baseline (scale-free) within 10% and its direction within 5 degrees.
+  const auto position = [](int frame) { return SceneWorldFromCam(frame).translation; };
+  const Eigen::Vector3d true_step = position(t_taken) - position(t_second);
+  const Eigen::Vector3d true_baseline = position(t_second) - position(t_first);
+  const Eigen::Vector3d step = taken.cam_from_world->Inverse().translation - second_centre;
+  const double true_ratio = true_step.norm() / true_baseline.norm();
+  EXPECT_NEAR(step.norm() / baseline, true_ratio, 0.1 * true_ratio);
+  const auto angle_deg = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * 180.0 / M_PI;
+  };
+  EXPECT_NEAR(angle_deg(step, second_centre - first_centre),
+              angle_deg(true_step, true_baseline), 5.0);
 }
 
 }  // namespace
