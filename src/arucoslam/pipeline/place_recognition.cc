@@ -84,6 +84,11 @@ std::optional<RelocalizationResult> PlaceRecognition::Relocalize(const Frame& fr
   return result;
 }
 
+void PlaceRecognition::RelocalizationTaken() {
+  std::lock_guard lock(*stats_mutex_);
+  ++stats_->num_relocalizations;
+}
+
 void PlaceRecognition::KeyframeMapped(KeyframeId keyframe) {
   if (threaded_) {
     // Never blocks local mapping: when the loop thread is far behind the keyframe is only

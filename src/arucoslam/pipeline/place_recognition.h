@@ -20,6 +20,7 @@
 #include "arucoslam/slam/keyframe_database.h"
 #include "arucoslam/slam/loop_closer.h"
 #include "arucoslam/slam/loop_detector.h"
+#include "arucoslam/slam/place_index.h"
 #include "arucoslam/slam/relocalizer.h"
 #include "arucoslam/util/timing.h"
 
@@ -71,58 +72,61 @@ struct PlaceRecognitionStats {
 // Thread safety: Relocalize runs on the tracking thread, KeyframeMapped on the mapping thread;
 // the database has its own lock. Map edits by local mapping and by loop closing are serialised
 // with LockMapEdits (local mapping waits while a loop is being closed).
-class PlaceRecognition {
+class PlaceRecognition final : public PlaceIndex {
  public:
   // `threaded`: loop closing and global BA run on their own threads; otherwise inline in
   // KeyframeMapped. Statistics are added to `stats` under `stats_mutex`.
   PlaceRecognition(Map& map, std::shared_ptr<const Vocabulary> vocabulary,
                    const PlaceRecognitionOptions& options, bool threaded,
                    PlaceRecognitionStats* stats, std::mutex* stats_mutex);
-  ~PlaceRecognition();
+  ~PlaceRecognition() override;
   PlaceRecognition(const PlaceRecognition&) = delete;
   PlaceRecognition& operator=(const PlaceRecognition&) = delete;
 
   // Pose of a lost frame from the database (frame features undistorted); nullopt when none.
-  std::optional<RelocalizationResult> Relocalize(const Frame& frame);
+  std::optional<RelocalizationResult> Relocalize(const Frame& frame) override;
+  // Counted in PlaceRecognitionStats::num_relocalizations.
+  void RelocalizationTaken() override;
   // Every keyframe already in the map enters the database (a map loaded from a file).
-  void IndexExistingKeyframes();
+  void IndexExistingKeyframes() override;
   // ... or these (keyframes of a map merged into this one).
-  void IndexKeyframes(const std::vector<KeyframeId>& keyframes);
+  void IndexKeyframes(const std::vector<KeyframeId>& keyframes) override;
   // A keyframe finished local mapping: it enters the database and the loop detector.
-  void KeyframeMapped(KeyframeId keyframe);
+  void KeyframeMapped(KeyframeId keyframe) override;
   // Held by local mapping for each keyframe, and by loop closing and world alignment.
-  std::unique_lock<std::mutex> LockMapEdits() { return std::unique_lock(edit_mutex_); }
+  std::unique_lock<std::mutex> LockMapEdits() override { return std::unique_lock(edit_mutex_); }
   // The map was moved from outside (world alignment) while holding LockMapEdits: a running
   // global BA is discarded.
-  void MapMovedExternally();
+  void MapMovedExternally() override;
   // The loop closer keeps the monocular scale fixed once the map is metric (markers).
-  void SetMetricMap(bool metric);
+  void SetMetricMap(bool metric) override;
   // Once the map is in the marker world: the markers whose corner views join global BA (known
   // ones fixed, mapped ones estimated). Call it holding LockMapEdits; the landmarks are read
   // and written only under that lock. Null: keypoints only.
-  void SetMarkerLandmarks(MarkerLandmarks* landmarks) { marker_landmarks_ = landmarks; }
+  void SetMarkerLandmarks(MarkerLandmarks* landmarks) override { marker_landmarks_ = landmarks; }
   // Camera-centre priors that join global BA (the bridge over a tracking gap). Call it
   // holding LockMapEdits, like SetMarkerLandmarks.
-  void SetBundleAdjustmentPriors(std::vector<KeyframePosePrior> priors) {
+  void SetBundleAdjustmentPriors(std::vector<KeyframePosePrior> priors) override {
     bundle_adjustment_priors_ = std::move(priors);
   }
   // ... and the marker pose priors for the loops' essential graphs (LoopCloser::SetPosePriors;
   // the source is called on the loop-closing thread).
-  void SetLoopPosePriors(LoopCloser::PosePriorSource source, const EssentialGraphOptions& graph) {
+  void SetLoopPosePriors(LoopCloser::PosePriorSource source,
+                         const EssentialGraphOptions& graph) override {
     closer_.SetPosePriors(std::move(source), graph);
   }
   // Incremented by each closed loop and applied global BA: the tracking thread re-anchors
   // its last pose to its reference keyframe when this changes.
-  std::uint64_t corrections() const { return corrections_; }
+  std::uint64_t corrections() const override { return corrections_; }
   // Product of the scale changes that closed loops applied around `keyframe` (1 when none;
   // kept for culled keyframes). A pose held relative to the keyframe since this was `then`
   // has its offset multiplied by KeyframeScale / then.
-  double KeyframeScale(KeyframeId keyframe) const;
+  double KeyframeScale(KeyframeId keyframe) const override;
   // Multiplies the keyframes' KeyframeScale by a correction's scale changes (closed loops
   // here; the System's marker drift corrections from outside).
-  void RecordScaleChanges(const std::map<KeyframeId, double>& changes);
+  void RecordScaleChanges(const std::map<KeyframeId, double>& changes) override;
   // Waits for queued keyframes and a running global BA; idempotent.
-  void Finish();
+  void Finish() override;
 
  private:
   void AddToDatabase(KeyframeId keyframe);

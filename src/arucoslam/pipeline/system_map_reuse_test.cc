@@ -9,7 +9,7 @@
 
 #include "arucoslam/geometry/umeyama.h"
 #include "arucoslam/pipeline/system.h"
-#include "arucoslam/pipeline/system_test_scene.h"
+#include "arucoslam/slam/synthetic_marker_scene.h"
 #include "arucoslam/slam/synthetic_features.h"
 
 namespace arucoslam {

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "arucoslam/pipeline/system.h"
-#include "arucoslam/pipeline/system_test_scene.h"
+#include "arucoslam/slam/synthetic_marker_scene.h"
 
 namespace arucoslam {
 namespace {

@@ -12,6 +12,7 @@
 #include "arucoslam/markers/detector_regions.h"
 #include "arucoslam/markers/marker_map.h"
 #include "arucoslam/pipeline/place_recognition.h"
+#include "arucoslam/slam/frame_flow.h"
 #include "arucoslam/slam/initializer.h"
 #include "arucoslam/slam/keyframe_policy.h"
 #include "arucoslam/slam/local_mapper.h"
@@ -135,6 +136,8 @@ struct SystemOptions {
   PoseConsistencyOptions pose_consistency;
 
   bool Check(std::string* why = nullptr) const;
+  // The options of the SLAM flow these make.
+  FrameFlowOptions FlowOptions() const;
 };
 
 }  // namespace arucoslam

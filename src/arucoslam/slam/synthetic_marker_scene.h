@@ -1,5 +1,5 @@
-// Test scene of the pipeline tests: a camera moving sideways past a synthetic point cloud
-// and a row of known markers, with blackouts (frames without keypoints or markers).
+// Test scene of the SLAM and pipeline tests: a camera moving sideways past a synthetic point
+// cloud (SyntheticFeatureScene) and a row of known markers on a wall.
 #pragma once
 
 #include <array>
@@ -9,7 +9,9 @@
 #include <vector>
 
 #include "arucoslam/markers/marker_map.h"
-#include "arucoslam/pipeline/system.h"
+#include "arucoslam/geometry/camera.h"
+#include "arucoslam/geometry/pose_consistency.h"
+#include "arucoslam/markers/detector.h"
 #include "arucoslam/slam/synthetic_features.h"
 
 namespace arucoslam::test_scene {

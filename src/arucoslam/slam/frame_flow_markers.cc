@@ -1,34 +1,26 @@
-// System's marker handling: each frame's markers handed to the marker fusion, marker-only
-// poses, relocalisation from a marker pose, and the Sim(3) alignment of the keypoint map to
-// the world.
+// FrameFlow's marker side: relocalisation from a marker pose, marker-only poses, the Sim(3)
+// alignment of the keypoint map to the world, and the wiring of the online marker mapping.
 #include <optional>
 #include <set>
 #include <vector>
 
-#include "arucoslam/pipeline/system.h"
+#include "arucoslam/slam/frame_flow.h"
 #include "arucoslam/util/logging.h"
 
 namespace arucoslam {
-void System::LocateWithMarkers(Frame& frame, const std::vector<MarkerDetection>& detections,
-                               FrameReport& report) {
-  if (!marker_frontend_) return;
-  marker_mapping_.AdoptWorldOrigin(detections, frame.camera);
-  MapPrediction prediction;
-  prediction.world_aligned = anchoring_.aligned();
-  prediction.tracking = tracker_->state() == TrackingState::kTracking;
-  prediction.predicted_cam_from_map = tracker_->PredictedPose();
-  marker_frontend_->Locate(detections, *marker_mapping_.LocatingMarkers(), prediction,
-                           report.index, &frame, &marker_fusion_);
-  report.num_markers = marker_fusion_.num_markers();
+
+void FrameFlow::MakeLocalMapper() {
+  mapper_ = std::make_unique<LocalMapper>(*map_, options_.mapper);
+  if (options_.marker_map) {  // keyframes anchoring_ keeps are not culled
+    mapper_->SetKeyframeGuard(
+        [this](const Keyframe& keyframe) { return anchoring_.KeepsKeyframe(keyframe); });
+  }
+  if (!options_.inline_mapping && options_.yield_bundle_adjustment) {
+    mapper_->SetYieldRequest([this] { return mapping_->KeyframeWaiting(); });
+  }
 }
 
-void System::GuardMarkerKeyframes() {
-  if (!options_.marker_map) return;
-  mapper_->SetKeyframeGuard(
-      [this](const Keyframe& keyframe) { return anchoring_.KeepsKeyframe(keyframe); });
-}
-
-bool System::RelocalizeWithMarkers(Frame& frame, FrameReport& report) {
+bool FrameFlow::RelocalizeWithMarkers(Frame& frame, FrameReport& report) {
   const std::optional<MarkerFix>& fix = marker_fusion_.fix();
   if (!anchoring_.aligned() || !fix) return false;
   const TrackingResult result =
@@ -38,26 +30,24 @@ bool System::RelocalizeWithMarkers(Frame& frame, FrameReport& report) {
   report.message = "relocalised from markers";
   ARUCOSLAM_LOG_DEBUG("frame {}: relocalised from markers, {} inliers", report.index,
                       result.num_inliers);
-  std::lock_guard lock(stats_mutex_);
-  ++stats_.num_marker_relocalizations;
+  CountStat(&FrameFlowStats::num_marker_relocalizations);
   return true;
 }
 
-void System::MaybeAlignWorld(Frame& frame) {
+void FrameFlow::MaybeAlignWorld(Frame& frame) {
   const std::optional<AlignmentDecision> decision = anchoring_.DecideAlignment(*map_);
   if (!decision) return;
   const std::vector<WorldAnchor>& anchors = decision->anchors;
   const WorldAlignment& alignment = decision->alignment;
   const Sim3& world_from_map = alignment.world_from_map;
-  StopMappingThread();  // every queued keyframe is mapped first; mapping is idle below
+  mapping_->Pause();  // every queued keyframe is mapped first; mapping is idle below
   const std::set<KeyframeId>& absorbed = map_session_.absorbed_keyframes();
   if (anchoring_.aligned() && !absorbed.empty() && map_session_.LinkedToAbsorbedMap(*map_)) {
     // A merged map that shares points with this one now (a loop, fused points): a
     // re-alignment from this map's anchors alone would tear them apart. Markers correct the
     // map by fusion from here on (drift correction, marker corners in bundle adjustment).
     anchoring_.StopRealigning();
-    mapping_busy_ = false;
-    StartMappingThread();
+    mapping_->Resume();
     ARUCOSLAM_LOG_DEBUG("world re-alignment stopped: the merged map is linked to this one");
     return;
   }
@@ -76,8 +66,7 @@ void System::MaybeAlignWorld(Frame& frame) {
     frame.cam_from_world = world_from_map.TransformPose(frame.cam_from_world->Inverse()).Inverse();
   }
   if (MergeClosedMap()) CorrectAcrossBridge();
-  mapping_busy_ = false;
-  StartMappingThread();
+  mapping_->Resume();
   ARUCOSLAM_LOG_DEBUG("keypoint map {}aligned to the marker world: scale {:.4f}, {} of {} "
                       "anchors, rms {:.3f} m",
                       anchoring_.aligned() ? "re-" : "", world_from_map.scale,
@@ -87,13 +76,49 @@ void System::MaybeAlignWorld(Frame& frame) {
   RefreshKeyframePoseCache();
 }
 
-void System::RecordMarkerPose(const Frame& frame, FrameReport& report) {
+void FrameFlow::RecordMarkerPose(const Frame& frame, FrameReport& report) {
   const Rigid3 cam_from_world = marker_fusion_.fix()->world_from_cam.Inverse();
   report.cam_from_world = cam_from_world;
   report.marker_pose = true;
   pose_history_.RecordMarkerPose(frame, cam_from_world);
-  std::lock_guard lock(stats_mutex_);
-  ++stats_.num_marker_only_poses;
+  CountStat(&FrameFlowStats::num_marker_only_poses);
+}
+
+void FrameFlow::StartMarkerMapping() {
+  if (!marker_mapping_.Start()) return;
+  if (MarkerLandmarks* landmarks = marker_mapping_.landmarks_for_bundle_adjustment()) {
+    mapper_->SetMarkerLandmarks(landmarks);
+    // The caller holds the places' edit lock (LockPlacesForMapMove).
+    if (places_) places_->SetMarkerLandmarks(landmarks);
+  }
+  if (places_ && options_.world_anchoring.priors_in_loops) {
+    places_->SetLoopPosePriors([this] { return anchoring_.KnownMarkerPriors(); },
+                               options_.world_anchoring.marker_correction_graph);
+  }
+  // Keyframes mapped before the alignment are recorded now, at their aligned poses.
+  for (const KeyframeId& id : marker_mapping_.UnfedKeyframes(*map_)) {
+    marker_mapping_.AddKeyframe(*map_, id);
+  }
+}
+
+void FrameFlow::AdjustWholeMapWithMarkers(const char* when) {
+  if (!marker_mapping_.AdjustsWholeMap()) return;
+  // A global BA of the loop closer may be solving: it is discarded, and the landmarks it
+  // writes under this lock are not touched meanwhile.
+  const std::unique_lock<std::mutex> places_lock = LockPlacesForMapMove();
+  marker_mapping_.AdjustWholeMap(map_.get(), when);
+}
+
+void FrameFlow::CorrectDriftWithMarkers(KeyframeId keyframe) {
+  const std::optional<DriftCorrectionDecision> decision =
+      marker_mapping_.DecideDriftCorrection(*map_, anchoring_, keyframe);
+  if (!decision) return;
+  if (places_) places_->MapMovedExternally();
+  const EssentialGraphResult result = marker_mapping_.CorrectDrift(
+      map_.get(), keyframe, *decision, options_.world_anchoring.marker_correction_graph);
+  if (!result.applied) return;
+  if (places_) places_->RecordScaleChanges(result.scale_changes);
+  anchoring_.DriftCorrected();
 }
 
 }  // namespace arucoslam
