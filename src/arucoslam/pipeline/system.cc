@@ -42,6 +42,8 @@ MapInitializerOptions MakeMapInitializerOptions(const SystemOptions& options) {
 
 System::System(const CameraModel& camera, const SystemOptions& options)
     : camera_(camera),
+      tracked_camera_(camera),
+      radial_calibration_(options.radial_calibration),
       options_(options),
       extractor_(options.extractor),
       map_initializer_(camera, MakeMapInitializerOptions(options)),
@@ -161,6 +163,7 @@ void System::MapKeyframe(KeyframeId keyframe) {
   marker_mapping_.AddKeyframe(*map_, keyframe);
   CorrectDriftWithMarkers(keyframe);
   const LocalMappingResult r = mapper_->ProcessKeyframe(keyframe);
+  if (!options_.marker_map) CalibrateRadialDistortion();
   const bool yielded = r.bundle_adjustment.summary.stopped_early;
   const double elapsed = watch.ElapsedMilliseconds();
   if (places_) {
@@ -185,12 +188,52 @@ void System::MapKeyframe(KeyframeId keyframe) {
   if (yielded) ++stats_.num_yielded_bundle_adjustments;
 }
 
+CameraModel System::CurrentCamera() const {
+  std::lock_guard lock(camera_mutex_);
+  return camera_;
+}
+
+namespace {
+bool SameDistortion(const CameraModel& a, const CameraModel& b) {
+  return a.model == b.model && a.distortion == b.distortion;
+}
+}  // namespace
+
+void System::FollowCalibration(Frame& frame) {
+  const CameraModel camera = CurrentCamera();
+  if (!SameDistortion(camera, tracked_camera_)) {
+    pose_history_.Recalibrate(tracked_camera_, camera);
+    tracked_camera_ = camera;
+  }
+  if (!SameDistortion(frame.camera, camera) && frame.camera.fx == camera.fx &&
+      frame.camera.cx == camera.cx) {
+    frame.camera = camera;
+    UndistortFeatures(camera, &frame.features);
+  }
+}
+
+void System::CalibrateRadialDistortion() {
+  CameraModel camera = CurrentCamera();
+  const RadialCalibrationStep step = radial_calibration_.MaybeRefine(*map_, &camera);
+  if (!step.attempted) return;
+  ARUCOSLAM_LOG_INFO("radial calibration at {} keyframes: k {:+.4f}, cost {:.1f} -> {:.1f} ({})",
+                     map_->NumKeyframes(), step.k, step.cost_without, step.cost_with, step.message);
+  if (!step.applied) return;
+  {
+    std::lock_guard lock(camera_mutex_);
+    camera_ = camera;
+  }
+  std::lock_guard lock(stats_mutex_);
+  ++stats_.num_radial_calibrations;
+  stats_.radial_k1_correction += step.k;
+}
+
 FrameReport System::ProcessImage(const cv::Mat& grey, double timestamp_s) {
   const Stopwatch watch;
   Frame frame;
   frame.id = FrameId(num_frames_);
   frame.timestamp_s = timestamp_s;
-  frame.camera = camera_;
+  frame.camera = CurrentCamera();
   // Marker detection runs on the worker's thread meanwhile; the frame waits only for what
   // is left of it after extraction.
   if (marker_frontend_) marker_frontend_->StartDetection(grey, *marker_mapping_.LocatingMarkers());
@@ -200,7 +243,7 @@ FrameReport System::ProcessImage(const cv::Mat& grey, double timestamp_s) {
     if (marker_frontend_) marker_frontend_->AbandonDetection();
     throw;
   }
-  UndistortFeatures(camera_, &frame.features);
+  UndistortFeatures(frame.camera, &frame.features);
   frame.ResetMatches();
   const double extraction = watch.ElapsedMilliseconds();
   std::vector<MarkerDetection> detections;
@@ -224,6 +267,7 @@ FrameReport System::ProcessFrame(Frame frame, const std::vector<MarkerDetection>
   report.timestamp_s = frame.timestamp_s;
   report.num_features = static_cast<int>(frame.features.size());
   if (frame.map_point_ids.size() != frame.features.size()) frame.ResetMatches();
+  FollowCalibration(frame);
   LocateWithMarkers(frame, detections, report);
   const std::optional<MarkerFix>& fix = marker_fusion_.fix();
   if (tracker_->state() == TrackingState::kNotInitialized) {

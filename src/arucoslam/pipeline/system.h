@@ -31,6 +31,7 @@
 #include "arucoslam/slam/marker_fusion.h"
 #include "arucoslam/slam/online_marker_mapping.h"
 #include "arucoslam/slam/pose_history.h"
+#include "arucoslam/slam/radial_calibration.h"
 #include "arucoslam/slam/tracker.h"
 #include "arucoslam/slam/world_anchoring.h"
 #include "arucoslam/util/timing.h"
@@ -152,7 +153,16 @@ class System {
   void StopMappingThread();
   bool MapperIdle() const;
 
-  CameraModel camera_;
+  CameraModel camera_;  // the calibration new frames take; the mapping thread refines it
+  mutable std::mutex camera_mutex_;  // guards camera_
+  CameraModel tracked_camera_;  // tracking thread: the calibration of the poses it recorded
+  CameraModel CurrentCamera() const;
+  // Tracking thread: a refined calibration reaches the frame (undistorted again when it was
+  // extracted before) and the kept matches.
+  void FollowCalibration(Frame& frame);
+  // Mapping thread, keypoint-only maps: radial_calibration_'s attempt when due.
+  void CalibrateRadialDistortion();
+  RadialCalibration radial_calibration_;
   SystemOptions options_;
   OrbExtractor extractor_;
   MapInitializer map_initializer_;

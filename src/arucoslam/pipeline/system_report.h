@@ -74,6 +74,8 @@ struct SystemStats {
   int num_whole_map_marker_adjustments = 0;  // bundle adjustments of a whole map with markers
   int num_refined_frame_poses = 0;  // frames re-optimised against the final map at Finish
   int num_yielded_bundle_adjustments = 0;  // local BAs ended early for a waiting keyframe
+  int num_radial_calibrations = 0;   // refinements of the radial distortion applied
+  double radial_k1_correction = 0.0;  // their sum: what the calibration's k1 gained
   int num_inconsistent_poses = 0;   // frames left out of Trajectory (pose_consistency)
 };
 
