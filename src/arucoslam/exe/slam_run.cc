@@ -50,6 +50,8 @@ SlamRunStats MakeStats(const std::string& dataset_label, const FrameSource& sour
   out.map_points = static_cast<int>(system.map().NumMapPoints());
   out.refined_frame_poses = stats.num_refined_frame_poses;
   out.yielded_bundle_adjustments = stats.num_yielded_bundle_adjustments;
+  out.radial_calibrations = stats.num_radial_calibrations;
+  out.radial_k1_correction = stats.radial_k1_correction;
   out.marker_fix_frames = stats.marker_fusion.num_located_frames;
   out.marker_disambiguations = stats.marker_fusion.num_disambiguations;
   out.map_rotation_disambiguations = stats.marker_fusion.num_map_rotation_disambiguations;

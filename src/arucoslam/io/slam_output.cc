@@ -48,7 +48,9 @@ std::string FormatSlamStatsJson(const SlamRunStats& stats) {
                  {"loops_closed", stats.loops_closed},
                  {"global_bundle_adjustments", stats.global_bundle_adjustments},
                  {"refined_frame_poses", stats.refined_frame_poses},
-                 {"yielded_bundle_adjustments", stats.yielded_bundle_adjustments}};
+                 {"yielded_bundle_adjustments", stats.yielded_bundle_adjustments},
+                 {"radial_calibrations", stats.radial_calibrations},
+                 {"radial_k1_correction", stats.radial_k1_correction}};
   if (stats.markers) {
     json["marker_locations"] = {
         {"frames_with_fix", stats.marker_fix_frames},

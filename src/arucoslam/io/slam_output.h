@@ -41,6 +41,8 @@ struct SlamRunStats {
   int map_points = 0;                  // in the final map
   int refined_frame_poses = 0;         // frames re-optimised against the final map
   int yielded_bundle_adjustments = 0;  // threaded: local BAs ended early for a waiting keyframe
+  int radial_calibrations = 0;         // refinements of the camera's radial distortion applied
+  double radial_k1_correction = 0.0;   // what they added to its k1
   // With a marker map: frames with a usable marker location, of which one ambiguous
   // marker settled by the motion prediction, and frames whose pose came from markers alone.
   int marker_fix_frames = 0;
@@ -73,7 +75,8 @@ std::string FormatPlyPoints(const std::vector<Eigen::Vector3d>& points);
 // stats.json text: {"format": "arucoslam.stats/1", "dataset", "layout", "interrupted",
 // "frames": {..., "left_out", "dropped", with markers "unposed_without_markers"},
 // "tracking": {"losses", "relocalisations", ...}, "map": {..., "loops_closed",
-// "global_bundle_adjustments", "refined_frame_poses", "yielded_bundle_adjustments"}, with markers
+// "global_bundle_adjustments", "refined_frame_poses", "yielded_bundle_adjustments",
+// "radial_calibrations", "radial_k1_correction"}, with markers
 // "marker_locations":
 // {"frames_with_fix", "disambiguated_by_motion", "disambiguated_by_map_rotation",
 // "disambiguated_by_covisible_markers", "relocated_at_end", "posed_at_end",

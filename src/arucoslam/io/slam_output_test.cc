@@ -45,6 +45,7 @@ TEST(SlamOutput, WritesFourFilesThatReadBack) {
   stats.drift_beyond_gate = 6;
   stats.refined_frame_poses = 17;
   stats.yielded_bundle_adjustments = 9;
+  stats.radial_calibrations = 1;
   stats.inconsistent_poses = 5;
   stats.map_rotation_disambiguations = 3;
   TimingSummary summary;
@@ -68,6 +69,7 @@ TEST(SlamOutput, WritesFourFilesThatReadBack) {
   EXPECT_NE(json.find("\"drift_beyond_gate\": 6"), std::string::npos);
   EXPECT_NE(json.find("\"refined_frame_poses\": 17"), std::string::npos);
   EXPECT_NE(json.find("\"yielded_bundle_adjustments\": 9"), std::string::npos);
+  EXPECT_NE(json.find("\"radial_calibrations\": 1"), std::string::npos);
   EXPECT_NE(json.find("\"left_out\": 5"), std::string::npos);
   EXPECT_NE(json.find("\"dropped\": 0"), std::string::npos);
   EXPECT_NE(json.find("\"interrupted\": false"), std::string::npos);

@@ -4,6 +4,8 @@
 
 #include <set>
 
+#include "arucoslam/feature/undistort.h"
+
 namespace arucoslam {
 
 Keyframe* MapData::MutableKeyframe(KeyframeId id) {
@@ -198,6 +200,13 @@ void MapData::UpdateDescriptor(MapPointId id) {
   }
   const int best = MedianDescriptorIndex(descriptors);
   if (best >= 0) std::copy_n(descriptors[best], kOrbDescriptorBytes, point->descriptor.begin());
+}
+
+void MapData::RecalibrateKeyframes(const CameraModel& camera) {
+  for (auto& [id, keyframe] : keyframes_) {
+    keyframe.camera = camera;
+    UndistortFeatures(camera, &keyframe.features);
+  }
 }
 
 void MapData::UpdateNormalAndDepth(MapPointId id) {

@@ -54,6 +54,9 @@ class MapData {
   bool Absorb(const MapData& other, KeyframeId attach_to, AbsorbedIds* ids);
 
   void SetKeyframePose(KeyframeId keyframe, const Rigid3& cam_from_world);
+  // A refined calibration: every keyframe takes `camera` and its keypoints are undistorted
+  // again with it.
+  void RecalibrateKeyframes(const CameraModel& camera);
   void SetMapPointPosition(MapPointId point, const Eigen::Vector3d& p_in_world);
   // Recomputes the representative descriptor (least median Hamming distance).
   void UpdateDescriptor(MapPointId point);

@@ -50,6 +50,8 @@ void VisitOptions(SystemOptions& o, Visitor& visit) {
         "threaded, marker map: ... and while the map is not aligned to the marker world");
   visit("max_initialization_gap_s", o.max_initialization_gap_s,
         "the initialisation reference is replaced after this long, seconds");
+  visit("radial_calibration", o.radial_calibration,
+        "the camera's radial distortion refined from the map");
   visit("map_session", o.map_session,
         "lost maps: reset, closed, merged into the next map, the gap bridged; the backfill");
   visit("detector", o.detector, "marker detection (with a marker map)");

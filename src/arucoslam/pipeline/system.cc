@@ -139,7 +139,7 @@ FrameReport System::ProcessImage(const cv::Mat& grey, double timestamp_s) {
   Frame frame;
   frame.id = FrameId(num_frames_);
   frame.timestamp_s = timestamp_s;
-  frame.camera = camera_;
+  frame.camera = flow_.Camera();
   // Marker detection runs on the worker's thread meanwhile; the frame waits only for what
   // is left of it after extraction.
   if (marker_frontend_) {
@@ -151,7 +151,7 @@ FrameReport System::ProcessImage(const cv::Mat& grey, double timestamp_s) {
     if (marker_frontend_) marker_frontend_->AbandonDetection();
     throw;
   }
-  UndistortFeatures(camera_, &frame.features);
+  UndistortFeatures(frame.camera, &frame.features);
   frame.ResetMatches();
   const double extraction = watch.ElapsedMilliseconds();
   std::vector<MarkerDetection> detections;

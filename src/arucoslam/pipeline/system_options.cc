@@ -15,6 +15,7 @@ bool SystemOptions::Check(std::string* why) const {
   check.AtLeast("mapper_queue_capacity", mapper_queue_capacity, 1);
   check.Above("max_initialization_gap_s", max_initialization_gap_s, 0.0);
   check.Nested("map_session", map_session);
+  check.Nested("radial_calibration", radial_calibration);
   check.Nested("pose_consistency", pose_consistency);
   check.AtLeast("synchronous_young_map_keyframes", synchronous_young_map_keyframes, 0);
   check.Nested("detector", detector);
@@ -43,6 +44,7 @@ FrameFlowOptions SystemOptions::FlowOptions() const {
   flow.keyframes = keyframes;
   flow.mapper = mapper;
   flow.map_session = map_session;
+  flow.radial_calibration = radial_calibration;
   flow.marker_map = marker_map;
   flow.marker_fusion = marker_fusion;
   flow.world_anchoring = world_anchoring;

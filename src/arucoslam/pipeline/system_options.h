@@ -18,6 +18,7 @@
 #include "arucoslam/slam/local_mapper.h"
 #include "arucoslam/slam/map_initialization.h"
 #include "arucoslam/slam/map_session.h"
+#include "arucoslam/slam/radial_calibration.h"
 #include "arucoslam/slam/marker_fusion.h"
 #include "arucoslam/slam/marker_mapper.h"
 #include "arucoslam/slam/tracker.h"
@@ -61,6 +62,9 @@ struct SystemOptions {
   // What becomes of a map that lost tracking (reset, closed, merged into the next one, the
   // gap bridged) and how many frames a new map's backfill tracks (slam/map_session.h).
   MapSessionOptions map_session;
+  // The camera's radial distortion refined from the map, keypoint-only runs
+  // (slam/radial_calibration.h).
+  RadialCalibrationOptions radial_calibration;
 
   // Known markers (markers.json). When set, markers are detected in every image and located
   // (LocateCamera): frames without a keypoint pose get the marker pose, the keypoint map is

@@ -22,6 +22,8 @@ FrameFlow::FrameFlow(const CameraModel& camera, const FrameFlowOptions& options,
                      MappingControl* mapping, PlaceIndexFactory make_places,
                      FrameFlowStats* stats, std::mutex* stats_mutex)
     : camera_(camera),
+      tracked_camera_(camera),
+      radial_calibration_(options.radial_calibration),
       options_(options),
       mapping_(mapping),
       make_places_(std::move(make_places)),
@@ -57,6 +59,7 @@ MapPrediction FrameFlow::Prediction() const {
 }
 
 void FrameFlow::Process(Frame& frame, FrameReport& report) {
+  FollowCalibration(frame);
   const std::optional<MarkerFix>& fix = marker_fusion_.fix();
   if (tracker_->state() == TrackingState::kNotInitialized) {
     map_loaded_ ? LocalizeInLoadedMap(frame, report) : Initialize(frame, report);
@@ -226,6 +229,7 @@ LocalMappingResult FrameFlow::MapKeyframe(KeyframeId keyframe) {
   marker_mapping_.AddKeyframe(*map_, keyframe);
   CorrectDriftWithMarkers(keyframe);
   LocalMappingResult result = mapper_->ProcessKeyframe(keyframe);
+  if (!options_.marker_map) CalibrateRadialDistortion();
   if (places_) {
     edit.unlock();
     // Before a loop correction moves the map.

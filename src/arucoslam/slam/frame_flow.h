@@ -22,6 +22,7 @@
 #include "arucoslam/slam/online_marker_mapping.h"
 #include "arucoslam/slam/place_index.h"
 #include "arucoslam/slam/pose_history.h"
+#include "arucoslam/slam/radial_calibration.h"
 #include "arucoslam/slam/tracker.h"
 #include "arucoslam/slam/world_anchoring.h"
 
@@ -33,6 +34,7 @@ struct FrameFlowOptions {
   KeyframePolicyOptions keyframes;
   LocalMapperOptions mapper;
   MapSessionOptions map_session;
+  RadialCalibrationOptions radial_calibration;  // keypoint-only maps
   std::optional<MarkerMap> marker_map;  // the known markers; none: keypoints only
   MarkerFusionOptions marker_fusion;
   WorldAnchoringOptions world_anchoring;
@@ -67,6 +69,9 @@ class FrameFlow {
   FrameFlow(const FrameFlow&) = delete;
   FrameFlow& operator=(const FrameFlow&) = delete;
 
+  // The calibration new frames take: the camera given, its radial distortion refined by
+  // radial_calibration on keypoint-only maps (any thread).
+  CameraModel Camera() const;
   // What the map tells marker location about the next frame.
   MapPrediction Prediction() const;
   // A frame whose markers were located (marker_fusion()): initialised, tracked or
@@ -149,7 +154,16 @@ class FrameFlow {
   // The frames kept for the backfill, tracked from `second` back in time.
   void BackfillInitialization(const Frame& second, KeyframeId first_id, KeyframeId second_id);
 
-  CameraModel camera_;
+  // Radial calibration (frame_flow_calibration.cc). Tracking thread: a refined calibration
+  // reaches the frame (undistorted again when extracted before it) and the kept matches.
+  void FollowCalibration(Frame& frame);
+  // Mapping thread, keypoint-only maps: radial_calibration_'s attempt when due.
+  void CalibrateRadialDistortion();
+
+  CameraModel camera_;  // guarded by camera_mutex_: the mapping thread refines it
+  mutable std::mutex camera_mutex_;
+  CameraModel tracked_camera_;  // tracking thread: the calibration of the poses it recorded
+  RadialCalibration radial_calibration_;
   FrameFlowOptions options_;
   MappingControl* mapping_;
   PlaceIndexFactory make_places_;

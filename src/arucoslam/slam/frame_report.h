@@ -54,6 +54,8 @@ struct FrameFlowStats {
   int num_marker_initializations = 0;  // maps initialised from two marker locations
   int num_refined_frame_poses = 0;  // frames re-optimised against the final map at Finish
   int num_inconsistent_poses = 0;   // frames left out of Trajectory (pose_consistency)
+  int num_radial_calibrations = 0;   // refinements of the radial distortion applied
+  double radial_k1_correction = 0.0;  // their sum: what the calibration's k1 gained
 };
 
 }  // namespace arucoslam

@@ -16,6 +16,7 @@
 #include "arucoslam/slam/map_session.h"
 #include "arucoslam/slam/marker_fusion.h"
 #include "arucoslam/slam/marker_mapper.h"
+#include "arucoslam/slam/radial_calibration.h"
 #include "arucoslam/slam/relocalizer.h"
 #include "arucoslam/slam/tracker.h"
 #include "arucoslam/slam/world_alignment.h"
@@ -336,6 +337,20 @@ void VisitOptions(WorldAnchoringOptions& o, Visitor& visit) {
         "the pose graph of marker corrections");
   visit("priors_in_loops", o.priors_in_loops,
         "loops in the aligned map corrected with the marker priors");
+}
+
+template <class Visitor>
+void VisitOptions(RadialCalibrationOptions& o, Visitor& visit) {
+  visit("enabled", o.enabled,
+        "refine the camera's radial distortion from the map (keypoint-only runs)");
+  visit("first_keyframes", o.first_keyframes,
+        "first attempt at this many keyframes, each later one at twice the count before");
+  visit("max_attempts", o.max_attempts, "attempts at most");
+  visit("min_cost_decrease", o.min_cost_decrease,
+        "kept when the whole-map cost falls by at least this fraction with the correction");
+  visit("max_abs_k", o.max_abs_k,
+        "... and the correction stays within this, normalised coordinates");
+  visit("solver", o.solver, "the whole-map solves");
 }
 
 template <class Visitor>

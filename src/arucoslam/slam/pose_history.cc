@@ -211,4 +211,16 @@ std::optional<Sim3> PoseHistory::LastPoseCorrection(const Map& map) const {
          Sim3(last.cam_from_world);
 }
 
+void PoseHistory::Recalibrate(const CameraModel& before, const CameraModel& after) {
+  const Eigen::Vector2d focal(before.fx, before.fy), centre(before.cx, before.cy);
+  for (TrackedPose& pose : poses_) {
+    for (FrameMatch& match : pose.matches) {
+      const Eigen::Vector2d normalised =
+          (match.pixel.cast<double>() - centre).cwiseQuotient(focal);
+      const Eigen::Vector2d raw = before.Distort(normalised);
+      match.pixel = (centre + focal.cwiseProduct(after.Unproject(raw))).cast<float>();
+    }
+  }
+}
+
 }  // namespace arucoslam

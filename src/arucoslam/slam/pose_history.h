@@ -56,6 +56,9 @@ class PoseHistory {
               const std::optional<MarkerFix>& fix, bool in_place = false);
   // A frame posed by its markers alone, in the world and tied to no keyframe.
   void RecordMarkerPose(const Frame& frame, const Rigid3& cam_from_world);
+  // The calibration was refined from `before` to `after` (same intrinsics matrix): the kept
+  // matches' undistorted pixels are undistorted again with `after`.
+  void Recalibrate(const CameraModel& before, const CameraModel& after);
   // Frames tracked back in time from a new map's first keyframe (`reference`): each takes the
   // place of a marker-only pose of the same frame; time order is kept. Returns how many poses
   // were replaced.

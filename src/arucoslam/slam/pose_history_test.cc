@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -233,6 +234,37 @@ TEST_F(PoseHistoryRefinement, LeavesAPoseWhoseMatchedPointsAreMostlyGone) {
   });
   EXPECT_EQ(Refine(), 0);
   ExpectSamePose(kRecorded.Inverse(), WorldFromCam());
+}
+
+// A refined calibration reaches the kept matches: their pixels are what the new camera makes
+// of the same raw pixels, and going back restores them.
+TEST_F(PoseHistoryRefinement, KeptMatchesFollowARefinedCalibration) {
+  CameraModel pinhole;
+  pinhole.width = 640;
+  pinhole.height = 480;
+  pinhole.fx = pinhole.fy = 500.0;
+  pinhole.cx = 320.0;
+  pinhole.cy = 240.0;
+  CameraModel radial = pinhole;
+  radial.model = DistortionModel::kRadTan;
+  radial.distortion[0] = 0.03;
+  const std::vector<FrameMatch> before = history_.poses()[0].matches;
+  ASSERT_EQ(before.size(), 30u);
+  history_.Recalibrate(pinhole, radial);
+  const std::vector<FrameMatch>& after = history_.poses()[0].matches;
+  double largest_move = 0.0;
+  for (std::size_t i = 0; i < before.size(); ++i) {
+    const Eigen::Vector2d raw = before[i].pixel.cast<double>();  // pinhole: undistorted = raw
+    const Eigen::Vector2d expected =
+        Eigen::Vector2d(320.0, 240.0) + 500.0 * radial.Unproject(raw);
+    EXPECT_LT((after[i].pixel.cast<double>() - expected).norm(), 1e-3) << i;
+    largest_move = std::max(largest_move, double{(after[i].pixel - before[i].pixel).norm()});
+  }
+  EXPECT_GT(largest_move, 0.1);  // the correction moved the matches off-centre
+  history_.Recalibrate(radial, pinhole);
+  for (std::size_t i = 0; i < before.size(); ++i) {
+    EXPECT_LT((history_.poses()[0].matches[i].pixel - before[i].pixel).norm(), 1e-3) << i;
+  }
 }
 
 }  // namespace
