@@ -18,7 +18,7 @@ namespace {
 using ceres_internal::kPoseSize;
 using ceres_internal::PoseFromBlock;
 using ceres_internal::PoseToBlock;
-using ceres_internal::ReprojectionCost;
+using ceres_internal::ReprojectionCosts;
 using ceres_internal::Se3LeftManifold;
 
 // Parameter blocks of a problem in Ceres' layout and which of them observations use.
@@ -67,13 +67,14 @@ struct CeresBlocks {
 
 // One residual block per observation; manifold and constancy set once per block.
 void AddResiduals(const BundleAdjustmentProblem& problem, ceres::Manifold* manifold,
-                  ceres::LossFunction* loss, CeresBlocks* blocks, ceres::Problem* ceres_problem) {
+                  ceres::LossFunction* loss, ReprojectionCosts* costs, CeresBlocks* blocks,
+                  ceres::Problem* ceres_problem) {
   for (const auto& observation : problem.observations) {
     double* pose_block = blocks->poses[observation.pose_index].data();
     double* point_block = blocks->points[observation.point_index].data();
     ceres_problem->AddResidualBlock(
-        new ReprojectionCost(problem.intrinsics, observation.pixel, observation.sigma_px), loss,
-        pose_block, point_block);
+        costs->Add(problem.intrinsics, observation.pixel, observation.sigma_px), loss, pose_block,
+        point_block);
     if (!blocks->pose_used[observation.pose_index]) {
       blocks->pose_used[observation.pose_index] = true;
       ceres_problem->SetManifold(pose_block, manifold);
@@ -100,13 +101,15 @@ BundleAdjustmentSummary SolveBundleAdjustment(const BundleAdjustmentOptions& opt
   summary.initial_rms_px = ReprojectionRmsPixels(*problem);
 
   CeresBlocks blocks(*problem);
+  ReprojectionCosts costs(problem->observations.size());
   ceres::Problem::Options problem_options;
+  problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem ceres_problem(problem_options);
   Se3LeftManifold manifold;
   ceres::HuberLoss loss(options.huber_delta_px);
-  AddResiduals(*problem, &manifold, &loss, &blocks, &ceres_problem);
+  AddResiduals(*problem, &manifold, &loss, &costs, &blocks, &ceres_problem);
   if (ceres_internal::NothingToSolve(ceres_problem, "no observations", &summary)) return summary;
 
   ceres_internal::SolveOptions solve_options =

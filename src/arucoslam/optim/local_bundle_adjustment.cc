@@ -74,14 +74,22 @@ Snapshot TakeSnapshot(const MapData& data, KeyframeId current,
        data.covisibility().BestCovisible(current, options.max_covisible_keyframes)) {
     local.push_back(id);
   }
-  std::set<MapPointId> points;
+  // The window's points in id order, each looked up once.
+  std::vector<MapPointId> point_ids;
   for (const KeyframeId& id : local) {
-    for (const MapPointId& point : data.MapPointsOf(id)) points.insert(point);
+    const std::vector<MapPointId> observed = data.MapPointsOf(id);
+    point_ids.insert(point_ids.end(), observed.begin(), observed.end());
   }
+  std::sort(point_ids.begin(), point_ids.end());
+  point_ids.erase(std::unique(point_ids.begin(), point_ids.end()), point_ids.end());
+  std::vector<const MapPoint*> points;
+  points.reserve(point_ids.size());
+  for (const MapPointId& id : point_ids) points.push_back(data.FindMapPoint(id));
+
   const std::set<KeyframeId> local_set(local.begin(), local.end());
   std::map<KeyframeId, int> border_points;  // border keyframe -> window points it observes
-  for (const MapPointId& point : points) {
-    for (const auto& [observer, index] : data.FindMapPoint(point)->observations) {
+  for (const MapPoint* point : points) {
+    for (const auto& [observer, index] : point->observations) {
       if (local_set.count(observer) == 0) ++border_points[observer];
     }
   }
@@ -90,43 +98,47 @@ Snapshot TakeSnapshot(const MapData& data, KeyframeId current,
   const std::set<KeyframeId> fixed = ChooseFixed(data, current, local, border_points, options);
 
   snapshot.problem.intrinsics = PinholeIntrinsics::FromCamera(keyframe->camera);
-  std::map<KeyframeId, std::size_t> pose_index;
+  // Per observer: its problem pose, its keyframe, and min_relative_depth x its median depth.
+  struct Observer {
+    std::size_t pose_index = 0;
+    const Keyframe* keyframe = nullptr;
+    double min_depth = 0.0;
+  };
+  std::map<KeyframeId, Observer> observers;
   for (const std::set<KeyframeId>* group :
        std::vector<const std::set<KeyframeId>*>{&local_set, &border}) {
     for (const KeyframeId& id : *group) {
-      pose_index[id] = snapshot.problem.poses.size();
-      snapshot.problem.poses.push_back(
-          {data.FindKeyframe(id)->cam_from_world, fixed.count(id) != 0});
+      const Keyframe* observer = data.FindKeyframe(id);
+      observers[id] = {snapshot.problem.poses.size(), observer, 0.0};
+      snapshot.problem.poses.push_back({observer->cam_from_world, fixed.count(id) != 0});
       snapshot.keyframe_ids.push_back(id);
     }
   }
-  std::map<KeyframeId, double> min_depth;  // per observer: min_relative_depth x median depth
-  for (const auto& [id, index] : pose_index) {
-    min_depth[id] = options.min_relative_depth * MedianPointDepth(data, *data.FindKeyframe(id));
+  for (auto& [id, observer] : observers) {
+    observer.min_depth = options.min_relative_depth * MedianPointDepth(data, *observer.keyframe);
   }
-  std::vector<std::pair<KeyframeId, int>> kept;
-  for (const MapPointId& point_id : points) {
-    const MapPoint* point = data.FindMapPoint(point_id);
+  std::vector<std::pair<const Observer*, int>> kept;
+  for (std::size_t p = 0; p < points.size(); ++p) {
+    const MapPoint* point = points[p];
     kept.clear();
-    for (const auto& [observer, index] : point->observations) {
-      const double depth =
-          (data.FindKeyframe(observer)->cam_from_world * point->p_in_world).z();
-      if (depth <= 0.0 || depth < min_depth.at(observer)) {
-        snapshot.too_near.push_back({observer, point_id, index});
+    for (const auto& [observer_id, index] : point->observations) {
+      const Observer& observer = observers.at(observer_id);
+      const double depth = (observer.keyframe->cam_from_world * point->p_in_world).z();
+      if (depth <= 0.0 || depth < observer.min_depth) {
+        snapshot.too_near.push_back({observer_id, point_ids[p], index});
       } else {
-        kept.emplace_back(observer, index);
+        kept.emplace_back(&observer, index);
       }
     }
     if (kept.empty()) continue;
     const std::size_t point_index = snapshot.problem.points.size();
     // One view cannot place a point (its depth is free): it is held, constraining the pose.
     snapshot.problem.points.push_back({point->p_in_world, kept.size() < 2});
-    snapshot.point_ids.push_back(point_id);
+    snapshot.point_ids.push_back(point_ids[p]);
     for (const auto& [observer, index] : kept) {
-      const Keyframe* observer_keyframe = data.FindKeyframe(observer);
-      snapshot.problem.observations.push_back({pose_index.at(observer), point_index,
-                                               observer_keyframe->UndistortedPixel(index),
-                                               observer_keyframe->SigmaPx(index)});
+      snapshot.problem.observations.push_back({observer->pose_index, point_index,
+                                               observer->keyframe->UndistortedPixel(index),
+                                               observer->keyframe->SigmaPx(index)});
       snapshot.keypoint_indices.push_back(index);
     }
   }

@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "arucoslam/markers/marker_pose.h"
@@ -20,7 +21,7 @@ namespace {
 
 using ceres_internal::kPoseSize;
 using ceres_internal::PoseBlock;
-using ceres_internal::ReprojectionCost;
+using ceres_internal::ReprojectionCosts;
 using ceres_internal::WritePoseJacobian;
 using LeftSe3Manifold = ceres_internal::Se3LeftManifold;
 
@@ -140,6 +141,19 @@ struct Blocks {
   }
 };
 
+// The cost functions of one solve (the ceres::Problem does not own them); outlive the problem.
+struct Costs {
+  ReprojectionCosts keypoints;
+  std::vector<std::unique_ptr<ceres::CostFunction>> others;  // marker corners, priors
+
+  explicit Costs(std::size_t num_keypoint_observations) : keypoints(num_keypoint_observations) {}
+  template <typename Cost, typename... Args>
+  Cost* AddOther(Args&&... args) {
+    others.push_back(std::make_unique<Cost>(std::forward<Args>(args)...));
+    return static_cast<Cost*>(others.back().get());
+  }
+};
+
 // Marks a block used on first sight: manifold, constancy.
 void Use(double* block, bool fixed, ceres::Manifold* manifold, std::vector<bool>::reference used,
          ceres::Problem* ceres_problem) {
@@ -151,13 +165,13 @@ void Use(double* block, bool fixed, ceres::Manifold* manifold, std::vector<bool>
 
 void AddResiduals(const MarkerBundleAdjustmentProblem& problem, ceres::Manifold* manifold,
                   ceres::LossFunction* keypoint_loss, ceres::LossFunction* marker_loss,
-                  Blocks* blocks, ceres::Problem* ceres_problem) {
+                  Costs* costs, Blocks* blocks, ceres::Problem* ceres_problem) {
   const auto& keypoints = problem.keypoints;
   for (const auto& observation : keypoints.observations) {
     double* pose = blocks->poses[observation.pose_index].data();
     double* point = blocks->points[observation.point_index].data();
     ceres_problem->AddResidualBlock(
-        new ReprojectionCost(keypoints.intrinsics, observation.pixel, observation.sigma_px),
+        costs->keypoints.Add(keypoints.intrinsics, observation.pixel, observation.sigma_px),
         keypoint_loss, pose, point);
     Use(pose, keypoints.poses[observation.pose_index].fixed, manifold,
         blocks->pose_used[observation.pose_index], ceres_problem);
@@ -170,8 +184,8 @@ void AddResiduals(const MarkerBundleAdjustmentProblem& problem, ceres::Manifold*
     double* marker_block = blocks->markers[observation.marker_index].data();
     const MarkerCornerError error(keypoints.intrinsics, SquareCorners(marker.size),
                                   observation.corners_px);
-    ceres_problem->AddResidualBlock(new MarkerCornerCost(error, observation.sigma_px), marker_loss,
-                                    pose, marker_block);
+    ceres_problem->AddResidualBlock(costs->AddOther<MarkerCornerCost>(error, observation.sigma_px),
+                                    marker_loss, pose, marker_block);
     Use(pose, keypoints.poses[observation.pose_index].fixed, manifold,
         blocks->pose_used[observation.pose_index], ceres_problem);
     Use(marker_block, marker.fixed, manifold, blocks->marker_used[observation.marker_index],
@@ -180,7 +194,7 @@ void AddResiduals(const MarkerBundleAdjustmentProblem& problem, ceres::Manifold*
   // Only on poses an observation ties to the rest: a prior alone would just be met.
   for (const PositionPrior& prior : problem.position_priors) {
     if (!blocks->pose_used[prior.pose_index]) continue;
-    ceres_problem->AddResidualBlock(new PositionPriorCost(prior), nullptr,
+    ceres_problem->AddResidualBlock(costs->AddOther<PositionPriorCost>(prior), nullptr,
                                     blocks->poses[prior.pose_index].data());
   }
 }
@@ -188,7 +202,7 @@ void AddResiduals(const MarkerBundleAdjustmentProblem& problem, ceres::Manifold*
 // The ground-plane prior on every pose a residual uses, the plane starting from their mean.
 // False (nothing added) when no pose is used.
 bool AddGroundPlanePrior(const GroundPlanePriorOptions& options, ceres::Manifold* sphere,
-                         Blocks* blocks, ceres::Problem* ceres_problem) {
+                         Costs* costs, Blocks* blocks, ceres::Problem* ceres_problem) {
   std::vector<Rigid3> poses;
   for (std::size_t i = 0; i < blocks->poses.size(); ++i) {
     if (blocks->pose_used[i]) poses.push_back(FromBlock(blocks->poses[i].data()));
@@ -199,8 +213,9 @@ bool AddGroundPlanePrior(const GroundPlanePriorOptions& options, ceres::Manifold
   blocks->ground_up = {start.up_in_camera.x(), start.up_in_camera.y(), start.up_in_camera.z()};
   for (std::size_t i = 0; i < blocks->poses.size(); ++i) {
     if (!blocks->pose_used[i]) continue;
-    ceres_problem->AddResidualBlock(new GroundPlaneCost(options), nullptr, blocks->poses[i].data(),
-                                    &blocks->ground_height, blocks->ground_up.data());
+    ceres_problem->AddResidualBlock(costs->AddOther<GroundPlaneCost>(options), nullptr,
+                                    blocks->poses[i].data(), &blocks->ground_height,
+                                    blocks->ground_up.data());
   }
   ceres_problem->SetManifold(blocks->ground_up.data(), sphere);
   return true;
@@ -238,18 +253,20 @@ MarkerBundleAdjustmentSummary SolveMarkerBundleAdjustment(
   summary.initial_marker_rms_px = MarkerReprojectionRmsPixels(*problem);
 
   Blocks blocks(*problem);
+  Costs costs(problem->keypoints.observations.size());
   ceres::Problem::Options problem_options;
+  problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem ceres_problem(problem_options);
   LeftSe3Manifold manifold;
   ceres::HuberLoss keypoint_loss(options.solver.huber_delta_px);
   ceres::HuberLoss marker_loss(options.marker_huber_delta);
-  AddResiduals(*problem, &manifold, &keypoint_loss, &marker_loss, &blocks, &ceres_problem);
+  AddResiduals(*problem, &manifold, &keypoint_loss, &marker_loss, &costs, &blocks, &ceres_problem);
   ceres::SphereManifold<3> sphere;
   const bool ground_plane =
       problem->ground_plane_prior &&
-      AddGroundPlanePrior(*problem->ground_plane_prior, &sphere, &blocks, &ceres_problem);
+      AddGroundPlanePrior(*problem->ground_plane_prior, &sphere, &costs, &blocks, &ceres_problem);
   if (ceres_internal::NothingToSolve(ceres_problem, "no observations", &summary)) return summary;
 
   // Points eliminated first; poses and markers form the reduced camera system.

@@ -5,6 +5,9 @@
 #include <ceres/ceres.h>
 
 #include <Eigen/Core>
+#include <cstddef>
+#include <optional>
+#include <vector>
 
 #include "arucoslam/optim/reprojection_error.h"
 #include "arucoslam/optim/se3_manifold_ceres.h"
@@ -48,6 +51,25 @@ class ReprojectionCost : public ceres::SizedCostFunction<2, kPoseSize, 3> {
  private:
   ReprojectionError error_;
   double inverse_sigma_;
+};
+
+// The reprojection costs of one solve in a single allocation, for a ceres::Problem built with
+// cost_function_ownership = DO_NOT_TAKE_OWNERSHIP: no allocation and no Ceres ownership
+// bookkeeping per residual block. Must outlive the problem.
+class ReprojectionCosts {
+ public:
+  explicit ReprojectionCosts(std::size_t capacity) : costs_(capacity) {}
+  // The next cost; at most `capacity` of them.
+  ReprojectionCost* Add(const PinholeIntrinsics& intrinsics, const Eigen::Vector2d& pixel,
+                        double sigma_px) {
+    std::optional<ReprojectionCost>& slot = costs_.at(size_++);
+    slot.emplace(intrinsics, pixel, sigma_px);
+    return &*slot;
+  }
+
+ private:
+  std::vector<std::optional<ReprojectionCost>> costs_;  // never reallocated: Ceres keeps pointers
+  std::size_t size_ = 0;
 };
 
 }  // namespace arucoslam::ceres_internal

@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <stdexcept>
+#include <vector>
 
 #include "arucoslam/optim/reprojection_cost_ceres.h"
 
@@ -142,6 +144,25 @@ TEST(ReprojectionCostTest, ResidualIsReprojectionErrorOverSigma) {
   const Eigen::Vector2d residual = Residual(cost, PoseToBlock(cam_from_world), p_in_world);
   EXPECT_NEAR(residual.x(), (458.0 * 0.25 + 367.0 - 480.0) / 2.0, 1e-12);
   EXPECT_NEAR(residual.y(), (457.0 * -0.125 + 248.0 - 200.0) / 2.0, 1e-12);
+}
+
+// Costs handed out by the store are distinct, each with its own observation, and stay valid
+// (the store never reallocates) until it is full; one more is refused.
+TEST(ReprojectionCostTest, StoreHandsOutStableCostsUpToItsCapacity) {
+  const Rigid3 cam_from_world(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.0, 0.0, 1.0));
+  const Eigen::Vector3d p_in_world(0.5, -0.25, 1.0);  // projects to (481.5, 190.875) px
+  constexpr int kCapacity = 40;
+  ceres_internal::ReprojectionCosts costs(kCapacity);
+  std::vector<ReprojectionCost*> handed;
+  for (int i = 0; i < kCapacity; ++i) {
+    handed.push_back(costs.Add(kIntrinsics, Eigen::Vector2d(480.0 - i, 200.0), 1.0 + i));
+  }
+  for (int i = 0; i < kCapacity; ++i) {
+    const Eigen::Vector2d residual = Residual(*handed[i], PoseToBlock(cam_from_world), p_in_world);
+    EXPECT_NEAR(residual.x(), (458.0 * 0.25 + 367.0 - (480.0 - i)) / (1.0 + i), 1e-12) << i;
+    EXPECT_NEAR(residual.y(), (457.0 * -0.125 + 248.0 - 200.0) / (1.0 + i), 1e-12) << i;
+  }
+  EXPECT_THROW(costs.Add(kIntrinsics, Eigen::Vector2d(480.0, 200.0), 1.0), std::out_of_range);
 }
 
 TEST(ReprojectionCostTest, PointBehindTheCameraGivesNoInformation) {

@@ -1,6 +1,8 @@
 #include "arucoslam/slam/local_mapper.h"
 
 #include <algorithm>
+#include <utility>
+#include <vector>
 
 #include "arucoslam/util/logging.h"
 #include "arucoslam/util/option_check.h"
@@ -99,17 +101,24 @@ int LocalMapper::CullRecentPoints() {
 namespace {
 
 // Whether `candidate` has more than `fraction` of its points seen by at least `observers`
-// other keyframes at the same or a finer scale (level at most one above).
+// other keyframes at the same or a finer scale (level at most one above). Stops counting as
+// soon as the answer is settled either way.
 bool IsRedundant(const MapData& data, const Keyframe& candidate, double fraction,
                  int observers) {
-  int num_points = 0;
-  int num_redundant = 0;
+  std::vector<std::pair<const MapPoint*, int>> points;  // with the candidate's keypoint level
   for (std::size_t i = 0; i < candidate.map_point_ids.size(); ++i) {
-    const MapPoint* point = data.FindMapPoint(candidate.map_point_ids[i]);
-    if (point == nullptr) continue;
-    ++num_points;
+    if (const MapPoint* point = data.FindMapPoint(candidate.map_point_ids[i])) {
+      points.emplace_back(point, candidate.features.keypoints[i].octave);
+    }
+  }
+  const int num_points = static_cast<int>(points.size());
+  const double needed = fraction * num_points;  // redundant points must exceed this
+  int num_redundant = 0;
+  for (int k = 0; k < num_points; ++k) {
+    if (num_redundant > needed) return true;
+    if (num_redundant + (num_points - k) <= needed) return false;
+    const auto& [point, level] = points[k];
     if (point->NumObservations() <= observers) continue;
-    const int level = candidate.features.keypoints[i].octave;
     int count = 0;
     for (const auto& [other, index] : point->observations) {
       if (other == candidate.id) continue;
@@ -117,7 +126,7 @@ bool IsRedundant(const MapData& data, const Keyframe& candidate, double fraction
     }
     if (count >= observers) ++num_redundant;
   }
-  return num_points > 0 && num_redundant > fraction * num_points;
+  return num_points > 0 && num_redundant > needed;
 }
 
 int NumMapPoints(const Keyframe& keyframe) {

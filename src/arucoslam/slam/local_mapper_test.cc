@@ -264,6 +264,40 @@ TEST(LocalMapper, CullsRedundantKeyframesOneAtATime) {
   });
 }
 
+// Keyframe 1 of five, 7 of its points seen by keyframe 0 alone besides it, the others by all
+// five: redundant only when more than redundant_fraction of its points have three other
+// observers, half a point either side of that fraction (keyframes 2 and 3 guarded).
+TEST(LocalMapper, CullsAKeyframeOnlyAboveItsRedundantFraction) {
+  constexpr int kUnshared = 7;
+  for (const bool above : {true, false}) {
+    Scene scene(3);
+    Map map;
+    const auto keyframes = BuildMap(scene, map, {0, 1, 2, 3, 4}, [](int) { return true; });
+    int num_points = 0;
+    map.Write([&](MapData& data) {
+      const std::vector<MapPointId> points = data.MapPointsOf(keyframes[1].id);
+      num_points = static_cast<int>(points.size());
+      for (int i = 0; i < kUnshared; ++i) {
+        for (int k = 2; k < 5; ++k) data.EraseObservation(keyframes[k].id, points[i]);
+      }
+      return 0;
+    });
+    ASSERT_GT(num_points, 30);
+    LocalMapperOptions options;
+    const double shared = num_points - kUnshared;
+    options.redundant_fraction = (above ? shared - 0.5 : shared + 0.5) / num_points;
+    LocalMapper mapper(map, options);
+    const KeyframeId candidate = keyframes[1].id;
+    mapper.SetKeyframeGuard(
+        [candidate](const Keyframe& keyframe) { return keyframe.id != candidate; });
+    EXPECT_EQ(mapper.CullRedundantKeyframes(keyframes[4].id), above ? 1 : 0) << above;
+    map.Read([&](const MapData& data) {
+      EXPECT_EQ(data.FindKeyframe(candidate) == nullptr, above);
+      return 0;
+    });
+  }
+}
+
 // Keyframe 1 of five keeps 10 points, seen by keyframe 0 alone besides it: not covisible with
 // keyframe 4, none of its points redundant. Under min_keyframe_points it is erased all the
 // same, unless guarded; with 10 points or more it stays.
