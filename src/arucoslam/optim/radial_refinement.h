@@ -11,7 +11,9 @@
 namespace arucoslam {
 
 struct RadialRefinementSummary {
-  BundleAdjustmentSummary solve;  // the joint solve (costs with k = 0 before, with k after)
+  // The joint solve: Ceres costs with k = 0 before and with k after; its RMS figures are the
+  // pinhole reprojection's, without the radial term.
+  BundleAdjustmentSummary solve;
   double k = 0.0;                 // the radial coefficient found
 };
 

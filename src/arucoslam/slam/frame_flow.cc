@@ -256,7 +256,7 @@ void FrameFlow::Finish() {
                                    options_.refine_min_inlier_fraction};
     refinement.optimization.keypoints = options_.tracker.pose;
     num_refined =
-        pose_history_.RefineAgainstMap(*map_, PinholeIntrinsics::FromCamera(camera_), refinement);
+        pose_history_.RefineAgainstMap(*map_, PinholeIntrinsics::FromCamera(Camera()), refinement);
   }
   int num_inconsistent = 0;
   const std::vector<StampedPose> trajectory = CheckedTrajectory(&num_inconsistent);
