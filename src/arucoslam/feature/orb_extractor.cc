@@ -63,6 +63,200 @@ class LazyPyramid {
   int built_ = 0;  // levels [0, built_] exist (or are known to be empty)
 };
 
+// The 16 pixels of FAST's circle of radius 3 in order around it, as (x, y) offsets.
+constexpr int kFastCircle[16][2] = {{0, 3},  {1, 3},   {2, 2},   {3, 1},   {3, 0},  {3, -1},
+                                    {2, -2}, {1, -3},  {0, -3},  {-1, -3}, {-2, -2}, {-3, -1},
+                                    {-3, 0}, {-3, 1},  {-2, 2},  {-1, 3}};
+constexpr int kFastArc = 9;  // contiguous circle pixels that make a corner (TYPE_9_16)
+
+// cv::FAST's score of a pixel (TYPE_9_16), the one its non-maximum suppression compares: one
+// less than the larger of `threshold` and the largest d for which kFastArc contiguous circle
+// pixels are all darker, or all brighter, than the centre by at least d. The minima and maxima
+// of the differences over every arc of kFastArc come from windows of doubling length.
+int FastCornerScore(const std::uint8_t* centre, const int* circle_offsets, int threshold) {
+  static_assert(kFastArc == 9, "windows of 2, 4, 8, then one more pixel");
+  constexpr int kLanes = 32;  // the circle twice, so that arcs never wrap
+  alignas(16) std::int16_t differences[kLanes + 8];
+  for (int k = 0; k < 16; ++k) {
+    differences[k] = differences[k + 16] =
+        static_cast<std::int16_t>(centre[0] - centre[circle_offsets[k]]);
+  }
+  for (int k = kLanes; k < kLanes + 8; ++k) differences[k] = differences[k - 16];
+#if CV_SIMD128
+  // lowest[k], highest[k]: min and max of differences[k .. k + width - 1], width 2, 4, 8.
+  alignas(16) std::int16_t lowest[kLanes + 8] = {}, highest[kLanes + 8] = {};
+  for (int k = 0; k < kLanes; k += 8) {
+    const cv::v_int16x8 a = cv::v_load(differences + k), b = cv::v_load(differences + k + 1);
+    cv::v_store(lowest + k, cv::v_min(a, b));
+    cv::v_store(highest + k, cv::v_max(a, b));
+  }
+  for (int width = 2; width < 8; width *= 2) {
+    for (int k = 0; k < kLanes - width; k += 8) {
+      cv::v_store(lowest + k, cv::v_min(cv::v_load(lowest + k), cv::v_load(lowest + k + width)));
+      cv::v_store(highest + k,
+                  cv::v_max(cv::v_load(highest + k), cv::v_load(highest + k + width)));
+    }
+  }
+  cv::v_int16x8 best = cv::v_setall_s16(static_cast<std::int16_t>(threshold));
+  for (int k = 0; k < 16; k += 8) {
+    const cv::v_int16x8 last = cv::v_load(differences + k + 8);
+    const cv::v_int16x8 darker = cv::v_min(cv::v_load(lowest + k), last);
+    const cv::v_int16x8 brighter = cv::v_max(cv::v_load(highest + k), last);
+    best = cv::v_max(best, cv::v_max(darker, cv::v_setzero_s16() - brighter));
+  }
+  return cv::v_reduce_max(best) - 1;
+#else
+  int best = threshold;
+  for (int start = 0; start < 16; ++start) {
+    int smallest = differences[start], largest = differences[start];
+    for (int k = start + 1; k < start + kFastArc; ++k) {
+      smallest = std::min<int>(smallest, differences[k]);
+      largest = std::max<int>(largest, differences[k]);
+    }
+    best = std::max(best, std::max(smallest, -largest));
+  }
+  return best - 1;
+#endif
+}
+
+// The grid of cells over the detection region of one level that decides where the low
+// threshold is tried; the last column and row of cells may be cut short by the region.
+struct CellGrid {
+  CellGrid(const cv::Rect& region, int cell_size)
+      : region(region),
+        cell_size(cell_size),
+        cells_x((region.width + cell_size - 1) / cell_size),
+        cells_y((region.height + cell_size - 1) / cell_size),
+        corner_counts(static_cast<std::size_t>(cells_x) * cells_y, 0) {}
+
+  int CellX(int x) const { return (x - region.x) / cell_size; }
+  int CellY(int y) const { return (y - region.y) / cell_size; }
+  bool Empty(int cx, int cy) const { return corner_counts[cy * cells_x + cx] == 0; }
+  // Cells [cx_begin, cx_end) of row cy as one rectangle.
+  cv::Rect Cells(int cx_begin, int cx_end, int cy) const {
+    return cv::Rect(region.x + cx_begin * cell_size, region.y + cy * cell_size,
+                    (cx_end - cx_begin) * cell_size, cell_size) &
+           region;
+  }
+
+  cv::Rect region;
+  int cell_size;
+  int cells_x, cells_y;
+  std::vector<int> corner_counts;  // corners of the initial threshold in each cell
+};
+
+cv::Rect PaddedForFast(const cv::Rect& rect) {
+  return cv::Rect(rect.x - kFastBorder, rect.y - kFastBorder, rect.width + 2 * kFastBorder,
+                  rect.height + 2 * kFastBorder);
+}
+
+// Corners of the initial threshold over the whole region, counted per cell.
+void DetectStrongCorners(const cv::Mat& image, int threshold, CellGrid& grid,
+                         std::vector<cv::KeyPoint>& corners) {
+  const cv::Rect padded = PaddedForFast(grid.region);
+  std::vector<cv::KeyPoint> found;
+  cv::FAST(image(padded), found, threshold, true);
+  for (cv::KeyPoint& kp : found) {
+    kp.pt.x += padded.x;
+    kp.pt.y += padded.y;
+    const cv::Point pixel(cvRound(kp.pt.x), cvRound(kp.pt.y));
+    if (!grid.region.contains(pixel)) continue;
+    ++grid.corner_counts[grid.CellY(pixel.y) * grid.cells_x + grid.CellX(pixel.x)];
+    corners.push_back(kp);
+  }
+}
+
+// FAST scores over a rectangle with a frame of zeros, so that every pixel of the rectangle
+// has eight neighbours; 0 where no candidate is.
+class ScoreMap {
+ public:
+  explicit ScoreMap(const cv::Rect& rect)
+      : rect_(rect),
+        step_(rect.width + 2),
+        scores_(static_cast<std::size_t>(step_) * (rect.height + 2), 0) {}
+  std::uint8_t& At(int x, int y) { return scores_[(y - rect_.y + 1) * step_ + (x - rect_.x + 1)]; }
+
+ private:
+  cv::Rect rect_;
+  int step_;
+  std::vector<std::uint8_t> scores_;
+};
+
+// Whether the score at (x, y) is above those of its eight neighbours inside the columns
+// [x_begin, x_end) (the rows are the score map's own); a neighbour outside counts as 0.
+bool StrongestInCell(ScoreMap& scores, int x, int y, int x_begin, int x_end) {
+  const int score = scores.At(x, y);
+  const int left = x > x_begin ? -1 : 0, right = x + 1 < x_end ? 1 : 0;
+  for (int dy = -1; dy <= 1; ++dy) {
+    for (int dx = left; dx <= right; ++dx) {
+      if ((dx != 0 || dy != 0) && score <= scores.At(x + dx, y + dy)) return false;
+    }
+  }
+  return true;
+}
+
+// Corners of `threshold` in the empty cells [cx_begin, cx_end) of row cy, appended cell by
+// cell and row-major inside each, exactly as cv::FAST with non-maximum suppression finds them
+// in each cell searched alone: a corner is kept when its score beats those of its eight
+// neighbours inside its cell (a neighbour outside the cell counts as 0). One cv::FAST call
+// over the whole run finds the candidates.
+void DetectWeakCornersInRun(const cv::Mat& image, int threshold, const CellGrid& grid,
+                            int cx_begin, int cx_end, int cy, std::vector<cv::KeyPoint>& corners) {
+  const cv::Rect run = grid.Cells(cx_begin, cx_end, cy);
+  const cv::Rect search = PaddedForFast(run);
+  std::vector<cv::KeyPoint> candidates;
+  cv::FAST(image(search), candidates, threshold, false);
+  if (candidates.empty()) return;
+  const int step = static_cast<int>(image.step1());
+  int circle_offsets[16];
+  for (int k = 0; k < 16; ++k) circle_offsets[k] = kFastCircle[k][0] + kFastCircle[k][1] * step;
+  ScoreMap scores(run);
+  for (cv::KeyPoint& kp : candidates) {
+    const int x = cvRound(kp.pt.x) + search.x, y = cvRound(kp.pt.y) + search.y;
+    kp.pt = cv::Point2f(static_cast<float>(x), static_cast<float>(y));
+    scores.At(x, y) = static_cast<std::uint8_t>(
+        FastCornerScore(image.ptr<std::uint8_t>(y) + x, circle_offsets, threshold));
+  }
+  // The corners kept, sorted by cell (stable, so row-major inside each).
+  std::vector<int> cell_of(candidates.size(), -1);
+  std::vector<int> first_of_cell(cx_end - cx_begin + 1, 0);
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const int x = static_cast<int>(candidates[i].pt.x), y = static_cast<int>(candidates[i].pt.y);
+    const int cx = grid.CellX(x);
+    const cv::Rect cell = grid.Cells(cx, cx + 1, cy);
+    if (!StrongestInCell(scores, x, y, cell.x, cell.x + cell.width)) continue;
+    cell_of[i] = cx - cx_begin;
+    ++first_of_cell[cx - cx_begin + 1];
+  }
+  for (std::size_t c = 1; c < first_of_cell.size(); ++c) first_of_cell[c] += first_of_cell[c - 1];
+  const std::size_t base = corners.size();
+  corners.resize(base + first_of_cell.back());
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    if (cell_of[i] < 0) continue;
+    const cv::KeyPoint& kp = candidates[i];
+    corners[base + first_of_cell[cell_of[i]]++] =
+        cv::KeyPoint(kp.pt, kp.size, -1.0f, static_cast<float>(scores.At(cvRound(kp.pt.x), cvRound(kp.pt.y))));
+  }
+}
+
+// Corners of `threshold` in the cells the initial threshold left empty, row by row of cells;
+// each run of adjacent empty cells of a row is searched at once.
+void DetectWeakCorners(const cv::Mat& image, int threshold, const CellGrid& grid,
+                       std::vector<cv::KeyPoint>& corners) {
+  for (int cy = 0; cy < grid.cells_y; ++cy) {
+    int cx = 0;
+    while (cx < grid.cells_x) {
+      if (!grid.Empty(cx, cy)) {
+        ++cx;
+        continue;
+      }
+      const int run_begin = cx;
+      while (cx < grid.cells_x && grid.Empty(cx, cy)) ++cx;
+      DetectWeakCornersInRun(image, threshold, grid, run_begin, cx, cy, corners);
+    }
+  }
+}
+
 // FAST corners inside [margin, cols - margin) x [margin, rows - margin) of one level: the
 // initial threshold over the whole region, the low one in grid cells left empty.
 std::vector<cv::KeyPoint> DetectCorners(const cv::Mat& image, const OrbExtractorOptions& options) {
@@ -70,42 +264,10 @@ std::vector<cv::KeyPoint> DetectCorners(const cv::Mat& image, const OrbExtractor
   const cv::Rect inner(margin, margin, image.cols - 2 * margin, image.rows - 2 * margin);
   std::vector<cv::KeyPoint> corners;
   if (inner.width <= 0 || inner.height <= 0) return corners;
-  const cv::Rect padded(inner.x - kFastBorder, inner.y - kFastBorder, inner.width + 2 * kFastBorder,
-                        inner.height + 2 * kFastBorder);
-  std::vector<cv::KeyPoint> found;
-  cv::FAST(image(padded), found, options.initial_fast_threshold, true);
-  const int cell = options.cell_size_px;
-  const int cells_x = (inner.width + cell - 1) / cell;
-  const int cells_y = (inner.height + cell - 1) / cell;
-  std::vector<int> per_cell(cells_x * cells_y, 0);
-  for (cv::KeyPoint& kp : found) {
-    kp.pt.x += padded.x;
-    kp.pt.y += padded.y;
-    if (!inner.contains(cv::Point(cvRound(kp.pt.x), cvRound(kp.pt.y)))) continue;
-    const int cx = (cvRound(kp.pt.x) - inner.x) / cell;
-    const int cy = (cvRound(kp.pt.y) - inner.y) / cell;
-    ++per_cell[cy * cells_x + cx];
-    corners.push_back(kp);
-  }
+  CellGrid grid(inner, options.cell_size_px);
+  DetectStrongCorners(image, options.initial_fast_threshold, grid, corners);
   if (options.min_fast_threshold >= options.initial_fast_threshold) return corners;
-  for (int cy = 0; cy < cells_y; ++cy) {
-    for (int cx = 0; cx < cells_x; ++cx) {
-      if (per_cell[cy * cells_x + cx] > 0) continue;
-      const cv::Rect cell_rect =
-          cv::Rect(inner.x + cx * cell, inner.y + cy * cell, cell, cell) & inner;
-      const cv::Rect search(cell_rect.x - kFastBorder, cell_rect.y - kFastBorder,
-                            cell_rect.width + 2 * kFastBorder, cell_rect.height + 2 * kFastBorder);
-      std::vector<cv::KeyPoint> weak;
-      cv::FAST(image(search), weak, options.min_fast_threshold, true);
-      for (cv::KeyPoint& kp : weak) {
-        kp.pt.x += search.x;
-        kp.pt.y += search.y;
-        if (cell_rect.contains(cv::Point(cvRound(kp.pt.x), cvRound(kp.pt.y)))) {
-          corners.push_back(kp);
-        }
-      }
-    }
-  }
+  DetectWeakCorners(image, options.min_fast_threshold, grid, corners);
   return corners;
 }
 
