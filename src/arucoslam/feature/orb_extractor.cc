@@ -69,49 +69,60 @@ constexpr int kFastCircle[16][2] = {{0, 3},  {1, 3},   {2, 2},   {3, 1},   {3, 0
                                     {-3, 0}, {-3, 1},  {-2, 2},  {-1, 3}};
 constexpr int kFastArc = 9;  // contiguous circle pixels that make a corner (TYPE_9_16)
 
+#if CV_SIMD128
+// Minima and maxima over arcs of the circle starting at each of its 16 pixels (lanes 0-7 in
+// *_low, 8-15 in *_high): from arcs of kShift pixels to arcs of 2 kShift.
+template <int kShift>
+void WidenArcs(cv::v_int16x8& min_low, cv::v_int16x8& min_high, cv::v_int16x8& max_low,
+               cv::v_int16x8& max_high) {
+  const cv::v_int16x8 new_min_low = cv::v_min(min_low, cv::v_extract<kShift>(min_low, min_high));
+  const cv::v_int16x8 new_min_high = cv::v_min(min_high, cv::v_extract<kShift>(min_high, min_low));
+  const cv::v_int16x8 new_max_low = cv::v_max(max_low, cv::v_extract<kShift>(max_low, max_high));
+  const cv::v_int16x8 new_max_high = cv::v_max(max_high, cv::v_extract<kShift>(max_high, max_low));
+  min_low = new_min_low;
+  min_high = new_min_high;
+  max_low = new_max_low;
+  max_high = new_max_high;
+}
+#endif
+
 // cv::FAST's score of a pixel (TYPE_9_16), the one its non-maximum suppression compares: one
 // less than the larger of `threshold` and the largest d for which kFastArc contiguous circle
-// pixels are all darker, or all brighter, than the centre by at least d. The minima and maxima
-// of the differences over every arc of kFastArc come from windows of doubling length.
+// pixels are all darker, or all brighter, than the centre by at least d.
 int FastCornerScore(const std::uint8_t* centre, const int* circle_offsets, int threshold) {
-  static_assert(kFastArc == 9, "windows of 2, 4, 8, then one more pixel");
-  constexpr int kLanes = 32;  // the circle twice, so that arcs never wrap
-  alignas(16) std::int16_t differences[kLanes + 8];
-  for (int k = 0; k < 16; ++k) {
-    differences[k] = differences[k + 16] =
-        static_cast<std::int16_t>(centre[0] - centre[circle_offsets[k]]);
-  }
-  for (int k = kLanes; k < kLanes + 8; ++k) differences[k] = differences[k - 16];
+  static_assert(kFastArc == 9, "arcs of 2, 4, 8, then one more pixel");
 #if CV_SIMD128
-  // lowest[k], highest[k]: min and max of differences[k .. k + width - 1], width 2, 4, 8.
-  alignas(16) std::int16_t lowest[kLanes + 8] = {}, highest[kLanes + 8] = {};
-  for (int k = 0; k < kLanes; k += 8) {
-    const cv::v_int16x8 a = cv::v_load(differences + k), b = cv::v_load(differences + k + 1);
-    cv::v_store(lowest + k, cv::v_min(a, b));
-    cv::v_store(highest + k, cv::v_max(a, b));
-  }
-  for (int width = 2; width < 8; width *= 2) {
-    for (int k = 0; k < kLanes - width; k += 8) {
-      cv::v_store(lowest + k, cv::v_min(cv::v_load(lowest + k), cv::v_load(lowest + k + width)));
-      cv::v_store(highest + k,
-                  cv::v_max(cv::v_load(highest + k), cv::v_load(highest + k + width)));
-    }
-  }
-  cv::v_int16x8 best = cv::v_setall_s16(static_cast<std::int16_t>(threshold));
-  for (int k = 0; k < 16; k += 8) {
-    const cv::v_int16x8 last = cv::v_load(differences + k + 8);
-    const cv::v_int16x8 darker = cv::v_min(cv::v_load(lowest + k), last);
-    const cv::v_int16x8 brighter = cv::v_max(cv::v_load(highest + k), last);
-    best = cv::v_max(best, cv::v_max(darker, cv::v_setzero_s16() - brighter));
-  }
-  return cv::v_reduce_max(best) - 1;
+  // Lane k of (low, high): centre minus circle pixel k.
+  alignas(16) std::uint8_t circle[16];
+  for (int k = 0; k < 16; ++k) circle[k] = centre[circle_offsets[k]];
+  cv::v_uint16x8 circle_low, circle_high;
+  cv::v_expand(cv::v_load(circle), circle_low, circle_high);
+  const cv::v_int16x8 value = cv::v_setall_s16(static_cast<std::int16_t>(centre[0]));
+  const cv::v_int16x8 low = value - cv::v_reinterpret_as_s16(circle_low);
+  const cv::v_int16x8 high = value - cv::v_reinterpret_as_s16(circle_high);
+  cv::v_int16x8 min_low = low, min_high = high, max_low = low, max_high = high;
+  WidenArcs<1>(min_low, min_high, max_low, max_high);
+  WidenArcs<2>(min_low, min_high, max_low, max_high);
+  WidenArcs<4>(min_low, min_high, max_low, max_high);
+  // Arcs of 8 starting at k, then the pixel k + 8: the other half of the pair.
+  const cv::v_int16x8 darker_low = cv::v_min(min_low, high), darker_high = cv::v_min(min_high, low);
+  const cv::v_int16x8 brighter_low = cv::v_max(max_low, high);
+  const cv::v_int16x8 brighter_high = cv::v_max(max_high, low);
+  const cv::v_int16x8 zero = cv::v_setzero_s16();
+  cv::v_int16x8 best = cv::v_max(cv::v_max(darker_low, darker_high),
+                                 cv::v_max(zero - brighter_low, zero - brighter_high));
+  return std::max(threshold, static_cast<int>(cv::v_reduce_max(best))) - 1;
 #else
+  int differences[16 + kFastArc - 1];
+  for (int k = 0; k < 16 + kFastArc - 1; ++k) {
+    differences[k] = centre[0] - centre[circle_offsets[k % 16]];
+  }
   int best = threshold;
   for (int start = 0; start < 16; ++start) {
     int smallest = differences[start], largest = differences[start];
     for (int k = start + 1; k < start + kFastArc; ++k) {
-      smallest = std::min<int>(smallest, differences[k]);
-      largest = std::max<int>(largest, differences[k]);
+      smallest = std::min(smallest, differences[k]);
+      largest = std::max(largest, differences[k]);
     }
     best = std::max(best, std::max(smallest, -largest));
   }
@@ -150,22 +161,6 @@ cv::Rect PaddedForFast(const cv::Rect& rect) {
                   rect.height + 2 * kFastBorder);
 }
 
-// Corners of the initial threshold over the whole region, counted per cell.
-void DetectStrongCorners(const cv::Mat& image, int threshold, CellGrid& grid,
-                         std::vector<cv::KeyPoint>& corners) {
-  const cv::Rect padded = PaddedForFast(grid.region);
-  std::vector<cv::KeyPoint> found;
-  cv::FAST(image(padded), found, threshold, true);
-  for (cv::KeyPoint& kp : found) {
-    kp.pt.x += padded.x;
-    kp.pt.y += padded.y;
-    const cv::Point pixel(cvRound(kp.pt.x), cvRound(kp.pt.y));
-    if (!grid.region.contains(pixel)) continue;
-    ++grid.corner_counts[grid.CellY(pixel.y) * grid.cells_x + grid.CellX(pixel.x)];
-    corners.push_back(kp);
-  }
-}
-
 // FAST scores over a rectangle with a frame of zeros, so that every pixel of the rectangle
 // has eight neighbours; 0 where no candidate is.
 class ScoreMap {
@@ -174,7 +169,23 @@ class ScoreMap {
       : rect_(rect),
         step_(rect.width + 2),
         scores_(static_cast<std::size_t>(step_) * (rect.height + 2), 0) {}
-  std::uint8_t& At(int x, int y) { return scores_[(y - rect_.y + 1) * step_ + (x - rect_.x + 1)]; }
+  std::uint8_t& At(const cv::Point& p) {
+    return scores_[(p.y - rect_.y + 1) * step_ + (p.x - rect_.x + 1)];
+  }
+
+  // Whether the score at p is above those of its eight neighbours inside the columns
+  // [x_begin, x_end) (the rows are the map's own); a neighbour outside counts as 0. This is
+  // cv::FAST's non-maximum suppression when it searches those columns alone.
+  bool StrongestAround(const cv::Point& p, int x_begin, int x_end) {
+    const int score = At(p);
+    const int left = p.x > x_begin ? -1 : 0, right = p.x + 1 < x_end ? 1 : 0;
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = left; dx <= right; ++dx) {
+        if ((dx != 0 || dy != 0) && score <= At(cv::Point(p.x + dx, p.y + dy))) return false;
+      }
+    }
+    return true;
+  }
 
  private:
   cv::Rect rect_;
@@ -182,17 +193,46 @@ class ScoreMap {
   std::vector<std::uint8_t> scores_;
 };
 
-// Whether the score at (x, y) is above those of its eight neighbours inside the columns
-// [x_begin, x_end) (the rows are the score map's own); a neighbour outside counts as 0.
-bool StrongestInCell(ScoreMap& scores, int x, int y, int x_begin, int x_end) {
-  const int score = scores.At(x, y);
-  const int left = x > x_begin ? -1 : 0, right = x + 1 < x_end ? 1 : 0;
-  for (int dy = -1; dy <= 1; ++dy) {
-    for (int dx = left; dx <= right; ++dx) {
-      if ((dx != 0 || dy != 0) && score <= scores.At(x + dx, y + dy)) return false;
-    }
+// The FAST corners of `threshold` inside `region` before suppression, in level pixels and
+// row-major, with their scores in `scores` (which covers `region`).
+std::vector<cv::Point> ScoredCandidates(const cv::Mat& image, const cv::Rect& region,
+                                        int threshold, ScoreMap& scores) {
+  const cv::Rect search = PaddedForFast(region);
+  std::vector<cv::KeyPoint> found;
+  cv::FAST(image(search), found, threshold, false);
+  const int step = static_cast<int>(image.step1());
+  int circle_offsets[16];
+  for (int k = 0; k < 16; ++k) circle_offsets[k] = kFastCircle[k][0] + kFastCircle[k][1] * step;
+  std::vector<cv::Point> candidates;
+  candidates.reserve(found.size());
+  for (const cv::KeyPoint& kp : found) {
+    const cv::Point pixel(cvRound(kp.pt.x) + search.x, cvRound(kp.pt.y) + search.y);
+    scores.At(pixel) = static_cast<std::uint8_t>(
+        FastCornerScore(image.ptr<std::uint8_t>(pixel.y) + pixel.x, circle_offsets, threshold));
+    candidates.push_back(pixel);
   }
-  return true;
+  return candidates;
+}
+
+// A keypoint as cv::FAST reports one at level pixel `pixel`.
+cv::KeyPoint FastKeypoint(const cv::Point& pixel, int score) {
+  constexpr float kFastKeypointSize = 7.0f;
+  return cv::KeyPoint(cv::Point2f(static_cast<float>(pixel.x), static_cast<float>(pixel.y)),
+                      kFastKeypointSize, -1.0f, static_cast<float>(score));
+}
+
+// Corners of the initial threshold over the whole region, counted per cell, as one
+// cv::FAST call with non-maximum suppression over it finds them.
+void DetectStrongCorners(const cv::Mat& image, int threshold, CellGrid& grid,
+                         std::vector<cv::KeyPoint>& corners) {
+  ScoreMap scores(grid.region);
+  const std::vector<cv::Point> candidates =
+      ScoredCandidates(image, grid.region, threshold, scores);
+  for (const cv::Point& pixel : candidates) {
+    if (!scores.StrongestAround(pixel, grid.region.x, grid.region.br().x)) continue;
+    ++grid.corner_counts[grid.CellY(pixel.y) * grid.cells_x + grid.CellX(pixel.x)];
+    corners.push_back(FastKeypoint(pixel, scores.At(pixel)));
+  }
 }
 
 // Corners of `threshold` in the empty cells [cx_begin, cx_end) of row cy, appended cell by
@@ -203,28 +243,15 @@ bool StrongestInCell(ScoreMap& scores, int x, int y, int x_begin, int x_end) {
 void DetectWeakCornersInRun(const cv::Mat& image, int threshold, const CellGrid& grid,
                             int cx_begin, int cx_end, int cy, std::vector<cv::KeyPoint>& corners) {
   const cv::Rect run = grid.Cells(cx_begin, cx_end, cy);
-  const cv::Rect search = PaddedForFast(run);
-  std::vector<cv::KeyPoint> candidates;
-  cv::FAST(image(search), candidates, threshold, false);
-  if (candidates.empty()) return;
-  const int step = static_cast<int>(image.step1());
-  int circle_offsets[16];
-  for (int k = 0; k < 16; ++k) circle_offsets[k] = kFastCircle[k][0] + kFastCircle[k][1] * step;
   ScoreMap scores(run);
-  for (cv::KeyPoint& kp : candidates) {
-    const int x = cvRound(kp.pt.x) + search.x, y = cvRound(kp.pt.y) + search.y;
-    kp.pt = cv::Point2f(static_cast<float>(x), static_cast<float>(y));
-    scores.At(x, y) = static_cast<std::uint8_t>(
-        FastCornerScore(image.ptr<std::uint8_t>(y) + x, circle_offsets, threshold));
-  }
+  const std::vector<cv::Point> candidates = ScoredCandidates(image, run, threshold, scores);
   // The corners kept, sorted by cell (stable, so row-major inside each).
   std::vector<int> cell_of(candidates.size(), -1);
   std::vector<int> first_of_cell(cx_end - cx_begin + 1, 0);
   for (std::size_t i = 0; i < candidates.size(); ++i) {
-    const int x = static_cast<int>(candidates[i].pt.x), y = static_cast<int>(candidates[i].pt.y);
-    const int cx = grid.CellX(x);
+    const int cx = grid.CellX(candidates[i].x);
     const cv::Rect cell = grid.Cells(cx, cx + 1, cy);
-    if (!StrongestInCell(scores, x, y, cell.x, cell.x + cell.width)) continue;
+    if (!scores.StrongestAround(candidates[i], cell.x, cell.br().x)) continue;
     cell_of[i] = cx - cx_begin;
     ++first_of_cell[cx - cx_begin + 1];
   }
@@ -233,9 +260,8 @@ void DetectWeakCornersInRun(const cv::Mat& image, int threshold, const CellGrid&
   corners.resize(base + first_of_cell.back());
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     if (cell_of[i] < 0) continue;
-    const cv::KeyPoint& kp = candidates[i];
     corners[base + first_of_cell[cell_of[i]]++] =
-        cv::KeyPoint(kp.pt, kp.size, -1.0f, static_cast<float>(scores.At(cvRound(kp.pt.x), cvRound(kp.pt.y))));
+        FastKeypoint(candidates[i], scores.At(candidates[i]));
   }
 }
 
