@@ -71,12 +71,15 @@ std::vector<cv::KeyPoint> SpreadWithQuadtree(const std::vector<cv::KeyPoint>& ke
   while (!queue.empty() && occupied < target) {
     const int c = queue.top();
     queue.pop();
-    const Cell cell = cells[c];
-    if (cell.members.size() <= 1 || cell.x1 - cell.x0 < 1.0f || cell.y1 - cell.y0 < 1.0f) {
+    if (cells[c].members.size() <= 1 || cells[c].x1 - cells[c].x0 < 1.0f ||
+        cells[c].y1 - cells[c].y0 < 1.0f) {
       leaves.push_back(c);
-      if (cell.members.size() <= 1) break;  // every remaining cell has one member
+      if (cells[c].members.size() <= 1) break;  // every remaining cell has one member
       continue;
     }
+    // A split cell is never looked at again; its children take its members.
+    const Cell cell = {cells[c].x0, cells[c].y0, cells[c].x1, cells[c].y1,
+                       std::move(cells[c].members)};
     const float mx = 0.5f * (cell.x0 + cell.x1), my = 0.5f * (cell.y0 + cell.y1);
     Cell children[4] = {{cell.x0, cell.y0, mx, my, {}},
                         {mx, cell.y0, cell.x1, my, {}},
