@@ -198,7 +198,8 @@ class ScoreMap {
 std::vector<cv::Point> ScoredCandidates(const cv::Mat& image, const cv::Rect& region,
                                         int threshold, ScoreMap& scores) {
   const cv::Rect search = PaddedForFast(region);
-  std::vector<cv::KeyPoint> found;
+  // cv::FAST's output, kept from call to call (it only clears it) so that it grows only once.
+  thread_local std::vector<cv::KeyPoint> found;
   cv::FAST(image(search), found, threshold, false);
   const int step = static_cast<int>(image.step1());
   int circle_offsets[16];
