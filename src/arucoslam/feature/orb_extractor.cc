@@ -89,12 +89,14 @@ void WidenArcs(cv::v_int16x8& min_low, cv::v_int16x8& min_high, cv::v_int16x8& m
 // cv::FAST's score of a pixel (TYPE_9_16), the one its non-maximum suppression compares: one
 // less than the larger of `threshold` and the largest d for which kFastArc contiguous circle
 // pixels are all darker, or all brighter, than the centre by at least d.
-int FastCornerScore(const std::uint8_t* centre, const int* circle_offsets, int threshold) {
+int FastCornerScore(const std::uint8_t* centre, int step, int threshold) {
   static_assert(kFastArc == 9, "arcs of 2, 4, 8, then one more pixel");
 #if CV_SIMD128
   // Lane k of (low, high): centre minus circle pixel k.
   alignas(16) std::uint8_t circle[16];
-  for (int k = 0; k < 16; ++k) circle[k] = centre[circle_offsets[k]];
+  // Unrolled, so that the circle's offsets become constants once the row step is known.
+#pragma GCC unroll 16
+  for (int k = 0; k < 16; ++k) circle[k] = centre[kFastCircle[k][1] * step + kFastCircle[k][0]];
   cv::v_uint16x8 circle_low, circle_high;
   cv::v_expand(cv::v_load(circle), circle_low, circle_high);
   const cv::v_int16x8 value = cv::v_setall_s16(static_cast<std::int16_t>(centre[0]));
@@ -115,7 +117,7 @@ int FastCornerScore(const std::uint8_t* centre, const int* circle_offsets, int t
 #else
   int differences[16 + kFastArc - 1];
   for (int k = 0; k < 16 + kFastArc - 1; ++k) {
-    differences[k] = centre[0] - centre[circle_offsets[k % 16]];
+    differences[k] = centre[0] - centre[kFastCircle[k % 16][1] * step + kFastCircle[k % 16][0]];
   }
   int best = threshold;
   for (int start = 0; start < 16; ++start) {
@@ -202,14 +204,12 @@ std::vector<cv::Point> ScoredCandidates(const cv::Mat& image, const cv::Rect& re
   thread_local std::vector<cv::KeyPoint> found;
   cv::FAST(image(search), found, threshold, false);
   const int step = static_cast<int>(image.step1());
-  int circle_offsets[16];
-  for (int k = 0; k < 16; ++k) circle_offsets[k] = kFastCircle[k][0] + kFastCircle[k][1] * step;
   std::vector<cv::Point> candidates;
   candidates.reserve(found.size());
   for (const cv::KeyPoint& kp : found) {
     const cv::Point pixel(cvRound(kp.pt.x) + search.x, cvRound(kp.pt.y) + search.y);
     scores.At(pixel) = static_cast<std::uint8_t>(
-        FastCornerScore(image.ptr<std::uint8_t>(pixel.y) + pixel.x, circle_offsets, threshold));
+        FastCornerScore(image.ptr<std::uint8_t>(pixel.y) + pixel.x, step, threshold));
     candidates.push_back(pixel);
   }
   return candidates;
@@ -417,12 +417,26 @@ void Describe(const cv::Mat& blurred, const cv::KeyPoint& kp, const PatternColum
   alignas(16) int offsets_a[PatternColumns::kSize], offsets_b[PatternColumns::kSize];
   RotatedOffsets(pattern.ax, pattern.ay, c, s, step, offsets_a);
   RotatedOffsets(pattern.bx, pattern.by, c, s, step, offsets_b);
-  for (int byte = 0; byte < kOrbDescriptorBytes; ++byte) {
-    const int* a = offsets_a + 8 * byte;
-    const int* b = offsets_b + 8 * byte;
+  int i = 0;
+#if CV_SIMD128
+  // Sixteen tests at a time: lane k of a comparison is bit k of the two bytes it fills.
+  alignas(16) std::uint8_t first[16], second[16];
+  for (; i + 16 <= PatternColumns::kSize; i += 16) {
+    for (int k = 0; k < 16; ++k) {
+      first[k] = centre[offsets_a[i + k]];
+      second[k] = centre[offsets_b[i + k]];
+    }
+    const int bits = cv::v_signmask(cv::v_load(first) < cv::v_load(second));
+    descriptor[i / 8] = static_cast<std::uint8_t>(bits & 0xFF);
+    descriptor[i / 8 + 1] = static_cast<std::uint8_t>(bits >> 8);
+  }
+#endif
+  for (; i < PatternColumns::kSize; i += 8) {
     unsigned value = 0;
-    for (int bit = 0; bit < 8; ++bit) value |= unsigned{centre[a[bit]] < centre[b[bit]]} << bit;
-    descriptor[byte] = static_cast<std::uint8_t>(value);
+    for (int bit = 0; bit < 8; ++bit) {
+      value |= unsigned{centre[offsets_a[i + bit]] < centre[offsets_b[i + bit]]} << bit;
+    }
+    descriptor[i / 8] = static_cast<std::uint8_t>(value);
   }
 }
 
