@@ -133,15 +133,9 @@ void BM_MatchInWindow(benchmark::State& state) {
 }
 BENCHMARK(BM_MatchInWindow)->Unit(benchmark::kMillisecond);
 
-// One initialisation attempt on two real frames of the static clip (refused: the common
-// case while a tracker waits for parallax), with the real calibration.
-void BM_InitializeStaticPair(benchmark::State& state) {
-  const cv::Mat image1 = LoadFrame(0, 752), image2 = LoadFrame(50, 752);
-  if (image1.empty() || image2.empty()) {
-    state.SkipWithError("euroc_v101_micro missing");
-    return;
-  }
-  CameraModel camera;  // cam0 of EuRoC V1_01 (euroc_v101_micro/README.md)
+// cam0 of EuRoC V1_01 (euroc_v101_micro/README.md): radial-tangential, strong barrel.
+CameraModel EurocCam0() {
+  CameraModel camera;
   camera.width = 752;
   camera.height = 480;
   camera.fx = 458.654;
@@ -150,6 +144,35 @@ void BM_InitializeStaticPair(benchmark::State& state) {
   camera.cy = 248.375;
   camera.model = DistortionModel::kRadTan;
   camera.distortion = {-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05, 0.0};
+  return camera;
+}
+
+// UndistortFeatures on the keypoints of a real frame (1000) with the EuRoC calibration.
+void BM_UndistortFeatures(benchmark::State& state) {
+  const cv::Mat image = LoadFrame(10, 752);
+  if (image.empty()) {
+    state.SkipWithError("euroc_v101_micro missing");
+    return;
+  }
+  const CameraModel camera = EurocCam0();
+  OrbFeatures features = OrbExtractor().Extract(image);
+  for (auto _ : state) {
+    UndistortFeatures(camera, &features);
+    benchmark::DoNotOptimize(features.undistorted.data());
+  }
+  state.counters["keypoints"] = static_cast<double>(features.size());
+}
+BENCHMARK(BM_UndistortFeatures)->Unit(benchmark::kMicrosecond);
+
+// One initialisation attempt on two real frames of the static clip (refused: the common
+// case while a tracker waits for parallax), with the real calibration.
+void BM_InitializeStaticPair(benchmark::State& state) {
+  const cv::Mat image1 = LoadFrame(0, 752), image2 = LoadFrame(50, 752);
+  if (image1.empty() || image2.empty()) {
+    state.SkipWithError("euroc_v101_micro missing");
+    return;
+  }
+  const CameraModel camera = EurocCam0();
   const OrbExtractor extractor;
   OrbFeatures features1 = extractor.Extract(image1), features2 = extractor.Extract(image2);
   UndistortFeatures(camera, &features1);

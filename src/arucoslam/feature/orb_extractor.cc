@@ -63,6 +63,227 @@ class LazyPyramid {
   int built_ = 0;  // levels [0, built_] exist (or are known to be empty)
 };
 
+// The 16 pixels of FAST's circle of radius 3 in order around it, as (x, y) offsets.
+constexpr int kFastCircle[16][2] = {{0, 3},  {1, 3},   {2, 2},   {3, 1},   {3, 0},  {3, -1},
+                                    {2, -2}, {1, -3},  {0, -3},  {-1, -3}, {-2, -2}, {-3, -1},
+                                    {-3, 0}, {-3, 1},  {-2, 2},  {-1, 3}};
+constexpr int kFastArc = 9;  // contiguous circle pixels that make a corner (TYPE_9_16)
+
+#if CV_SIMD128
+// Minima and maxima over arcs of the circle starting at each of its 16 pixels (lanes 0-7 in
+// *_low, 8-15 in *_high): from arcs of kShift pixels to arcs of 2 kShift.
+template <int kShift>
+void WidenArcs(cv::v_int16x8& min_low, cv::v_int16x8& min_high, cv::v_int16x8& max_low,
+               cv::v_int16x8& max_high) {
+  const cv::v_int16x8 new_min_low = cv::v_min(min_low, cv::v_extract<kShift>(min_low, min_high));
+  const cv::v_int16x8 new_min_high = cv::v_min(min_high, cv::v_extract<kShift>(min_high, min_low));
+  const cv::v_int16x8 new_max_low = cv::v_max(max_low, cv::v_extract<kShift>(max_low, max_high));
+  const cv::v_int16x8 new_max_high = cv::v_max(max_high, cv::v_extract<kShift>(max_high, max_low));
+  min_low = new_min_low;
+  min_high = new_min_high;
+  max_low = new_max_low;
+  max_high = new_max_high;
+}
+#endif
+
+// cv::FAST's score of a pixel (TYPE_9_16), the one its non-maximum suppression compares: one
+// less than the larger of `threshold` and the largest d for which kFastArc contiguous circle
+// pixels are all darker, or all brighter, than the centre by at least d.
+int FastCornerScore(const std::uint8_t* centre, int step, int threshold) {
+  static_assert(kFastArc == 9, "arcs of 2, 4, 8, then one more pixel");
+#if CV_SIMD128
+  // Lane k of (low, high): centre minus circle pixel k.
+  alignas(16) std::uint8_t circle[16];
+  // Unrolled, so that the circle's offsets become constants once the row step is known.
+#pragma GCC unroll 16
+  for (int k = 0; k < 16; ++k) circle[k] = centre[kFastCircle[k][1] * step + kFastCircle[k][0]];
+  cv::v_uint16x8 circle_low, circle_high;
+  cv::v_expand(cv::v_load(circle), circle_low, circle_high);
+  const cv::v_int16x8 value = cv::v_setall_s16(static_cast<std::int16_t>(centre[0]));
+  const cv::v_int16x8 low = value - cv::v_reinterpret_as_s16(circle_low);
+  const cv::v_int16x8 high = value - cv::v_reinterpret_as_s16(circle_high);
+  cv::v_int16x8 min_low = low, min_high = high, max_low = low, max_high = high;
+  WidenArcs<1>(min_low, min_high, max_low, max_high);
+  WidenArcs<2>(min_low, min_high, max_low, max_high);
+  WidenArcs<4>(min_low, min_high, max_low, max_high);
+  // Arcs of 8 starting at k, then the pixel k + 8: the other half of the pair.
+  const cv::v_int16x8 darker_low = cv::v_min(min_low, high), darker_high = cv::v_min(min_high, low);
+  const cv::v_int16x8 brighter_low = cv::v_max(max_low, high);
+  const cv::v_int16x8 brighter_high = cv::v_max(max_high, low);
+  const cv::v_int16x8 zero = cv::v_setzero_s16();
+  cv::v_int16x8 best = cv::v_max(cv::v_max(darker_low, darker_high),
+                                 cv::v_max(zero - brighter_low, zero - brighter_high));
+  return std::max(threshold, static_cast<int>(cv::v_reduce_max(best))) - 1;
+#else
+  int differences[16 + kFastArc - 1];
+  for (int k = 0; k < 16 + kFastArc - 1; ++k) {
+    differences[k] = centre[0] - centre[kFastCircle[k % 16][1] * step + kFastCircle[k % 16][0]];
+  }
+  int best = threshold;
+  for (int start = 0; start < 16; ++start) {
+    int smallest = differences[start], largest = differences[start];
+    for (int k = start + 1; k < start + kFastArc; ++k) {
+      smallest = std::min(smallest, differences[k]);
+      largest = std::max(largest, differences[k]);
+    }
+    best = std::max(best, std::max(smallest, -largest));
+  }
+  return best - 1;
+#endif
+}
+
+// The grid of cells over the detection region of one level that decides where the low
+// threshold is tried; the last column and row of cells may be cut short by the region.
+struct CellGrid {
+  CellGrid(const cv::Rect& region, int cell_size)
+      : region(region),
+        cell_size(cell_size),
+        cells_x((region.width + cell_size - 1) / cell_size),
+        cells_y((region.height + cell_size - 1) / cell_size),
+        corner_counts(static_cast<std::size_t>(cells_x) * cells_y, 0) {}
+
+  int CellX(int x) const { return (x - region.x) / cell_size; }
+  int CellY(int y) const { return (y - region.y) / cell_size; }
+  bool Empty(int cx, int cy) const { return corner_counts[cy * cells_x + cx] == 0; }
+  // Cells [cx_begin, cx_end) of row cy as one rectangle.
+  cv::Rect Cells(int cx_begin, int cx_end, int cy) const {
+    return cv::Rect(region.x + cx_begin * cell_size, region.y + cy * cell_size,
+                    (cx_end - cx_begin) * cell_size, cell_size) &
+           region;
+  }
+
+  cv::Rect region;
+  int cell_size;
+  int cells_x, cells_y;
+  std::vector<int> corner_counts;  // corners of the initial threshold in each cell
+};
+
+cv::Rect PaddedForFast(const cv::Rect& rect) {
+  return cv::Rect(rect.x - kFastBorder, rect.y - kFastBorder, rect.width + 2 * kFastBorder,
+                  rect.height + 2 * kFastBorder);
+}
+
+// FAST scores over a rectangle with a frame of zeros, so that every pixel of the rectangle
+// has eight neighbours; 0 where no candidate is.
+class ScoreMap {
+ public:
+  explicit ScoreMap(const cv::Rect& rect)
+      : rect_(rect),
+        step_(rect.width + 2),
+        scores_(static_cast<std::size_t>(step_) * (rect.height + 2), 0) {}
+  std::uint8_t& At(const cv::Point& p) {
+    return scores_[(p.y - rect_.y + 1) * step_ + (p.x - rect_.x + 1)];
+  }
+
+  // Whether the score at p is above those of its eight neighbours inside the columns
+  // [x_begin, x_end) (the rows are the map's own); a neighbour outside counts as 0. This is
+  // cv::FAST's non-maximum suppression when it searches those columns alone.
+  bool StrongestAround(const cv::Point& p, int x_begin, int x_end) {
+    const int score = At(p);
+    const int left = p.x > x_begin ? -1 : 0, right = p.x + 1 < x_end ? 1 : 0;
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = left; dx <= right; ++dx) {
+        if ((dx != 0 || dy != 0) && score <= At(cv::Point(p.x + dx, p.y + dy))) return false;
+      }
+    }
+    return true;
+  }
+
+ private:
+  cv::Rect rect_;
+  int step_;
+  std::vector<std::uint8_t> scores_;
+};
+
+// The FAST corners of `threshold` inside `region` before suppression, in level pixels and
+// row-major, with their scores in `scores` (which covers `region`).
+std::vector<cv::Point> ScoredCandidates(const cv::Mat& image, const cv::Rect& region,
+                                        int threshold, ScoreMap& scores) {
+  const cv::Rect search = PaddedForFast(region);
+  // cv::FAST's output, kept from call to call (it only clears it) so that it grows only once.
+  thread_local std::vector<cv::KeyPoint> found;
+  cv::FAST(image(search), found, threshold, false);
+  const int step = static_cast<int>(image.step1());
+  std::vector<cv::Point> candidates;
+  candidates.reserve(found.size());
+  for (const cv::KeyPoint& kp : found) {
+    const cv::Point pixel(cvRound(kp.pt.x) + search.x, cvRound(kp.pt.y) + search.y);
+    scores.At(pixel) = static_cast<std::uint8_t>(
+        FastCornerScore(image.ptr<std::uint8_t>(pixel.y) + pixel.x, step, threshold));
+    candidates.push_back(pixel);
+  }
+  return candidates;
+}
+
+// A keypoint as cv::FAST reports one at level pixel `pixel`.
+cv::KeyPoint FastKeypoint(const cv::Point& pixel, int score) {
+  constexpr float kFastKeypointSize = 7.0f;
+  return cv::KeyPoint(cv::Point2f(static_cast<float>(pixel.x), static_cast<float>(pixel.y)),
+                      kFastKeypointSize, -1.0f, static_cast<float>(score));
+}
+
+// Corners of the initial threshold over the whole region, counted per cell, as one
+// cv::FAST call with non-maximum suppression over it finds them.
+void DetectStrongCorners(const cv::Mat& image, int threshold, CellGrid& grid,
+                         std::vector<cv::KeyPoint>& corners) {
+  ScoreMap scores(grid.region);
+  const std::vector<cv::Point> candidates =
+      ScoredCandidates(image, grid.region, threshold, scores);
+  for (const cv::Point& pixel : candidates) {
+    if (!scores.StrongestAround(pixel, grid.region.x, grid.region.br().x)) continue;
+    ++grid.corner_counts[grid.CellY(pixel.y) * grid.cells_x + grid.CellX(pixel.x)];
+    corners.push_back(FastKeypoint(pixel, scores.At(pixel)));
+  }
+}
+
+// Corners of `threshold` in the empty cells [cx_begin, cx_end) of row cy, appended cell by
+// cell and row-major inside each, exactly as cv::FAST with non-maximum suppression finds them
+// in each cell searched alone: a corner is kept when its score beats those of its eight
+// neighbours inside its cell (a neighbour outside the cell counts as 0). One cv::FAST call
+// over the whole run finds the candidates.
+void DetectWeakCornersInRun(const cv::Mat& image, int threshold, const CellGrid& grid,
+                            int cx_begin, int cx_end, int cy, std::vector<cv::KeyPoint>& corners) {
+  const cv::Rect run = grid.Cells(cx_begin, cx_end, cy);
+  ScoreMap scores(run);
+  const std::vector<cv::Point> candidates = ScoredCandidates(image, run, threshold, scores);
+  // The corners kept, sorted by cell (stable, so row-major inside each).
+  std::vector<int> cell_of(candidates.size(), -1);
+  std::vector<int> first_of_cell(cx_end - cx_begin + 1, 0);
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const int cx = grid.CellX(candidates[i].x);
+    const cv::Rect cell = grid.Cells(cx, cx + 1, cy);
+    if (!scores.StrongestAround(candidates[i], cell.x, cell.br().x)) continue;
+    cell_of[i] = cx - cx_begin;
+    ++first_of_cell[cx - cx_begin + 1];
+  }
+  for (std::size_t c = 1; c < first_of_cell.size(); ++c) first_of_cell[c] += first_of_cell[c - 1];
+  const std::size_t base = corners.size();
+  corners.resize(base + first_of_cell.back());
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    if (cell_of[i] < 0) continue;
+    corners[base + first_of_cell[cell_of[i]]++] =
+        FastKeypoint(candidates[i], scores.At(candidates[i]));
+  }
+}
+
+// Corners of `threshold` in the cells the initial threshold left empty, row by row of cells;
+// each run of adjacent empty cells of a row is searched at once.
+void DetectWeakCorners(const cv::Mat& image, int threshold, const CellGrid& grid,
+                       std::vector<cv::KeyPoint>& corners) {
+  for (int cy = 0; cy < grid.cells_y; ++cy) {
+    int cx = 0;
+    while (cx < grid.cells_x) {
+      if (!grid.Empty(cx, cy)) {
+        ++cx;
+        continue;
+      }
+      const int run_begin = cx;
+      while (cx < grid.cells_x && grid.Empty(cx, cy)) ++cx;
+      DetectWeakCornersInRun(image, threshold, grid, run_begin, cx, cy, corners);
+    }
+  }
+}
+
 // FAST corners inside [margin, cols - margin) x [margin, rows - margin) of one level: the
 // initial threshold over the whole region, the low one in grid cells left empty.
 std::vector<cv::KeyPoint> DetectCorners(const cv::Mat& image, const OrbExtractorOptions& options) {
@@ -70,42 +291,10 @@ std::vector<cv::KeyPoint> DetectCorners(const cv::Mat& image, const OrbExtractor
   const cv::Rect inner(margin, margin, image.cols - 2 * margin, image.rows - 2 * margin);
   std::vector<cv::KeyPoint> corners;
   if (inner.width <= 0 || inner.height <= 0) return corners;
-  const cv::Rect padded(inner.x - kFastBorder, inner.y - kFastBorder, inner.width + 2 * kFastBorder,
-                        inner.height + 2 * kFastBorder);
-  std::vector<cv::KeyPoint> found;
-  cv::FAST(image(padded), found, options.initial_fast_threshold, true);
-  const int cell = options.cell_size_px;
-  const int cells_x = (inner.width + cell - 1) / cell;
-  const int cells_y = (inner.height + cell - 1) / cell;
-  std::vector<int> per_cell(cells_x * cells_y, 0);
-  for (cv::KeyPoint& kp : found) {
-    kp.pt.x += padded.x;
-    kp.pt.y += padded.y;
-    if (!inner.contains(cv::Point(cvRound(kp.pt.x), cvRound(kp.pt.y)))) continue;
-    const int cx = (cvRound(kp.pt.x) - inner.x) / cell;
-    const int cy = (cvRound(kp.pt.y) - inner.y) / cell;
-    ++per_cell[cy * cells_x + cx];
-    corners.push_back(kp);
-  }
+  CellGrid grid(inner, options.cell_size_px);
+  DetectStrongCorners(image, options.initial_fast_threshold, grid, corners);
   if (options.min_fast_threshold >= options.initial_fast_threshold) return corners;
-  for (int cy = 0; cy < cells_y; ++cy) {
-    for (int cx = 0; cx < cells_x; ++cx) {
-      if (per_cell[cy * cells_x + cx] > 0) continue;
-      const cv::Rect cell_rect =
-          cv::Rect(inner.x + cx * cell, inner.y + cy * cell, cell, cell) & inner;
-      const cv::Rect search(cell_rect.x - kFastBorder, cell_rect.y - kFastBorder,
-                            cell_rect.width + 2 * kFastBorder, cell_rect.height + 2 * kFastBorder);
-      std::vector<cv::KeyPoint> weak;
-      cv::FAST(image(search), weak, options.min_fast_threshold, true);
-      for (cv::KeyPoint& kp : weak) {
-        kp.pt.x += search.x;
-        kp.pt.y += search.y;
-        if (cell_rect.contains(cv::Point(cvRound(kp.pt.x), cvRound(kp.pt.y)))) {
-          corners.push_back(kp);
-        }
-      }
-    }
-  }
+  DetectWeakCorners(image, options.min_fast_threshold, grid, corners);
   return corners;
 }
 
@@ -228,12 +417,26 @@ void Describe(const cv::Mat& blurred, const cv::KeyPoint& kp, const PatternColum
   alignas(16) int offsets_a[PatternColumns::kSize], offsets_b[PatternColumns::kSize];
   RotatedOffsets(pattern.ax, pattern.ay, c, s, step, offsets_a);
   RotatedOffsets(pattern.bx, pattern.by, c, s, step, offsets_b);
-  for (int byte = 0; byte < kOrbDescriptorBytes; ++byte) {
-    const int* a = offsets_a + 8 * byte;
-    const int* b = offsets_b + 8 * byte;
+  int i = 0;
+#if CV_SIMD128
+  // Sixteen tests at a time: lane k of a comparison is bit k of the two bytes it fills.
+  alignas(16) std::uint8_t first[16], second[16];
+  for (; i + 16 <= PatternColumns::kSize; i += 16) {
+    for (int k = 0; k < 16; ++k) {
+      first[k] = centre[offsets_a[i + k]];
+      second[k] = centre[offsets_b[i + k]];
+    }
+    const int bits = cv::v_signmask(cv::v_load(first) < cv::v_load(second));
+    descriptor[i / 8] = static_cast<std::uint8_t>(bits & 0xFF);
+    descriptor[i / 8 + 1] = static_cast<std::uint8_t>(bits >> 8);
+  }
+#endif
+  for (; i < PatternColumns::kSize; i += 8) {
     unsigned value = 0;
-    for (int bit = 0; bit < 8; ++bit) value |= unsigned{centre[a[bit]] < centre[b[bit]]} << bit;
-    descriptor[byte] = static_cast<std::uint8_t>(value);
+    for (int bit = 0; bit < 8; ++bit) {
+      value |= unsigned{centre[offsets_a[i + bit]] < centre[offsets_b[i + bit]]} << bit;
+    }
+    descriptor[i / 8] = static_cast<std::uint8_t>(value);
   }
 }
 
