@@ -41,8 +41,9 @@ void FrameFlow::MaybeAlignWorld(Frame& frame) {
   const WorldAlignment& alignment = decision->alignment;
   const Sim3& world_from_map = alignment.world_from_map;
   mapping_->Pause();  // every queued keyframe is mapped first; mapping is idle below
-  const std::set<KeyframeId>& absorbed = map_session_.absorbed_keyframes();
-  if (anchoring_.aligned() && !absorbed.empty() && map_session_.LinkedToAbsorbedMap(*map_)) {
+  const MapSession& session = lifecycle_.session();
+  const std::set<KeyframeId>& absorbed = session.absorbed_keyframes();
+  if (anchoring_.aligned() && !absorbed.empty() && session.LinkedToAbsorbedMap(*map_)) {
     // A merged map that shares points with this one now (a loop, fused points): a
     // re-alignment from this map's anchors alone would tear them apart. Markers correct the
     // map by fusion from here on (drift correction, marker corners in bundle adjustment).
@@ -54,7 +55,7 @@ void FrameFlow::MaybeAlignWorld(Frame& frame) {
   anchoring_.DropOutlierFixes(*decision);
   // A merged map not linked yet stays where it is (already in the world).
   const std::set<KeyframeId>* stay = absorbed.empty() ? nullptr : &absorbed;
-  const std::unique_lock<std::mutex> places_lock = LockPlacesForMapMove();
+  const std::unique_lock<std::mutex> places_lock = lifecycle_.LockPlacesForMapMove();
   // On a re-alignment the markers mapped in the previous estimate of the world move too.
   MarkerLandmarks* mapped = marker_mapping_.live_landmarks();
   map_->Write([&](MapData& data) { ApplyWorldAlignment(world_from_map, &data, mapped, stay); });
@@ -65,7 +66,7 @@ void FrameFlow::MaybeAlignWorld(Frame& frame) {
   if (frame.cam_from_world) {
     frame.cam_from_world = world_from_map.TransformPose(frame.cam_from_world->Inverse()).Inverse();
   }
-  if (MergeClosedMap()) CorrectAcrossBridge();
+  lifecycle_.MergeClosedMap(Parts());
   mapping_->Resume();
   ARUCOSLAM_LOG_DEBUG("keypoint map {}aligned to the marker world: scale {:.4f}, {} of {} "
                       "anchors, rms {:.3f} m",
@@ -73,7 +74,7 @@ void FrameFlow::MaybeAlignWorld(Frame& frame) {
                       alignment.num_inliers, anchors.size(), alignment.rms_m);
   anchoring_.AlignmentApplied(*decision);
   marker_fusion_.MapEnteredWorld(frame.timestamp_s);  // the anchors agree with the map
-  RefreshKeyframePoseCache();
+  lifecycle_.RefreshKeyframePoseCache(Parts());
 }
 
 void FrameFlow::RecordMarkerPose(const Frame& frame, FrameReport& report) {
@@ -86,13 +87,14 @@ void FrameFlow::RecordMarkerPose(const Frame& frame, FrameReport& report) {
 
 void FrameFlow::StartMarkerMapping() {
   if (!marker_mapping_.Start()) return;
+  PlaceIndex* places = lifecycle_.places();
   if (MarkerLandmarks* landmarks = marker_mapping_.landmarks_for_bundle_adjustment()) {
     mapper_->SetMarkerLandmarks(landmarks);
     // The caller holds the places' edit lock (LockPlacesForMapMove).
-    if (places_) places_->SetMarkerLandmarks(landmarks);
+    if (places) places->SetMarkerLandmarks(landmarks);
   }
-  if (places_ && options_.world_anchoring.priors_in_loops) {
-    places_->SetLoopPosePriors([this] { return anchoring_.KnownMarkerPriors(); },
+  if (places && options_.world_anchoring.priors_in_loops) {
+    places->SetLoopPosePriors([this] { return anchoring_.KnownMarkerPriors(); },
                                options_.world_anchoring.marker_correction_graph);
   }
   // Keyframes mapped before the alignment are recorded now, at their aligned poses.
@@ -101,23 +103,16 @@ void FrameFlow::StartMarkerMapping() {
   }
 }
 
-void FrameFlow::AdjustWholeMapWithMarkers(const char* when) {
-  if (!marker_mapping_.AdjustsWholeMap()) return;
-  // A global BA of the loop closer may be solving: it is discarded, and the landmarks it
-  // writes under this lock are not touched meanwhile.
-  const std::unique_lock<std::mutex> places_lock = LockPlacesForMapMove();
-  marker_mapping_.AdjustWholeMap(map_.get(), when);
-}
-
 void FrameFlow::CorrectDriftWithMarkers(KeyframeId keyframe) {
   const std::optional<DriftCorrectionDecision> decision =
       marker_mapping_.DecideDriftCorrection(*map_, anchoring_, keyframe);
   if (!decision) return;
-  if (places_) places_->MapMovedExternally();
+  PlaceIndex* places = lifecycle_.places();
+  if (places) places->MapMovedExternally();
   const EssentialGraphResult result = marker_mapping_.CorrectDrift(
       map_.get(), keyframe, *decision, options_.world_anchoring.marker_correction_graph);
   if (!result.applied) return;
-  if (places_) places_->RecordScaleChanges(result.scale_changes);
+  if (places) places->RecordScaleChanges(result.scale_changes);
   anchoring_.DriftCorrected();
 }
 
