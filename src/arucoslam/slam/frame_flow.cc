@@ -44,6 +44,7 @@ FrameFlow::FrameFlow(const CameraModel& camera, const FrameFlowOptions& options,
       marker_fusion_(MakeMarkerFusion(options, camera)),
       anchoring_(options.world_anchoring),
       marker_mapping_(options.marker_map, options.marker_mapping),
+      marker_world_(options, stats, stats_mutex),
       lifecycle_(options, std::move(make_places), stats, stats_mutex) {
   map_ = std::make_unique<Map>();
   tracker_ = std::make_unique<Tracker>(*map_, options_.tracker);
@@ -75,7 +76,9 @@ void FrameFlow::Process(Frame& frame, FrameReport& report) {
   }
   // A loaded map that stays outside the marker world takes no marker-only poses.
   const bool marker_poses = anchoring_.aligned() || !localize_only();
-  if (!report.cam_from_world && fix && marker_poses) RecordMarkerPose(frame, report);
+  if (!report.cam_from_world && fix && marker_poses) {
+    marker_world_.RecordMarkerPose(MarkerParts(), frame, report);
+  }
   if (!localize_only()) marker_mapping_.AddMarkerView(frame, marker_fusion_.fix());
   // Without a world pose now (none, or a keypoint pose outside the world without a marker
   // location), a frame that saw markers may be located at the end.
@@ -125,7 +128,7 @@ void FrameFlow::FinishInitialization(const InitialMap& initial, Frame& frame,
   lifecycle_.MapInitialized(Parts(), initial, frame);
   anchoring_.AddAnchor(first_id, initial.first_fix);
   anchoring_.AddAnchor(second_id, marker_fusion_.fix());
-  MaybeAlignWorld(frame);
+  marker_world_.MaybeAlign(MarkerParts(), frame);
   frames_since_keyframe_ = 0;
   last_state_ = TrackingState::kTracking;
   report.state = TrackingState::kTracking;
@@ -154,7 +157,7 @@ void FrameFlow::Track(Frame& frame, FrameReport& report) {
   }
   bool relocalized = false;
   if (result.state != TrackingState::kTracking &&
-      (RelocalizeWithMarkers(frame, report) ||
+      (marker_world_.Relocalize(MarkerParts(), frame, report) ||
        lifecycle_.RelocalizeWithPlaces(Parts(), frame, report) ||
        lifecycle_.RelocalizeInLoadedMap(Parts(), frame, report))) {
     result.state = TrackingState::kTracking;
@@ -219,7 +222,7 @@ void FrameFlow::MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& 
         options_.marker_map && !anchoring_.aligned() && options_.synchronous_until_aligned;
     if (young || unaligned) mapping_->WaitUntilMapped();
   }
-  MaybeAlignWorld(frame);
+  marker_world_.MaybeAlign(MarkerParts(), frame);
 }
 
 void FrameFlow::RecordPose(const Frame& frame, KeyframeId reference) {
@@ -231,7 +234,7 @@ LocalMappingResult FrameFlow::MapKeyframe(KeyframeId keyframe) {
   std::unique_lock<std::mutex> edit;  // a loop being closed pauses local mapping
   if (places) edit = places->LockMapEdits();
   marker_mapping_.AddKeyframe(*map_, keyframe);
-  CorrectDriftWithMarkers(keyframe);
+  marker_world_.CorrectDrift(*map_, keyframe, anchoring_, marker_mapping_, places);
   LocalMappingResult result = mapper_->ProcessKeyframe(keyframe);
   if (!options_.marker_map) CalibrateRadialDistortion();
   if (places) {

@@ -1,6 +1,6 @@
 // FrameFlow: the synchronous SLAM of one camera, one frame at a time: initialisation,
-// tracking and its relocalisation chain, keyframe decisions, world alignment; the maps one
-// after the other are MapLifecycle's.
+// tracking and its relocalisation chain, keyframe decisions; the marker world is MarkerWorld's,
+// the maps one after the other MapLifecycle's.
 #pragma once
 
 #include <cstddef>
@@ -17,6 +17,7 @@
 #include "arucoslam/slam/map_lifecycle.h"
 #include "arucoslam/slam/map_session.h"
 #include "arucoslam/slam/marker_fusion.h"
+#include "arucoslam/slam/marker_world.h"
 #include "arucoslam/slam/online_marker_mapping.h"
 #include "arucoslam/slam/pose_history.h"
 #include "arucoslam/slam/radial_calibration.h"
@@ -78,22 +79,12 @@ class FrameFlow {
   void RecordPose(const Frame& frame, KeyframeId reference);
   void CountStat(int FrameFlowStats::*counter, int amount = 1);
 
-  // Markers (frame_flow_markers.cc).
-  bool RelocalizeWithMarkers(Frame& frame, FrameReport& report);
-  // Aligns the map to the world when anchoring_ decides so; `frame` (the current one, its
-  // pose in the map) is carried along.
-  void MaybeAlignWorld(Frame& frame);
-  void RecordMarkerPose(const Frame& frame, FrameReport& report);
-  // marker_mapping_ wired to the map, the local mapper and the places on each world alignment.
-  void StartMarkerMapping();
-  // Mapping thread, after the keyframe's markers were mapped: the pose-graph correction when
-  // they contradict its pose.
-  void CorrectDriftWithMarkers(KeyframeId keyframe);
+  // The current map's objects, lent to lifecycle_ and marker_world_, and its replacement
+  // (frame_flow_maps.cc).
+  MapLifecycleParts Parts();
+  MarkerWorldParts MarkerParts();
   // A new mapper_ for map_: marker-keyframe guard and the BA's yield to a waiting keyframe.
   void MakeLocalMapper();
-
-  // The current map's side of lifecycle_ (frame_flow_maps.cc).
-  MapLifecycleParts Parts();
   void LocalizeInLoadedMap(Frame& frame, FrameReport& report);
   // A lost frame: the map is kept, or reset as lifecycle_ says.
   void HandleLostFrame(const Frame& frame, std::size_t frame_index);
@@ -129,6 +120,8 @@ class FrameFlow {
   // Markers mapped in the world; only the mapping thread touches it while it runs and the map
   // is live.
   OnlineMarkerMapping marker_mapping_;
+  // The current map's marker-world side: marker relocalisation and poses, world alignment.
+  MarkerWorld marker_world_;
   // The maps one after the other: loaded, relocalised into, lost, closed, merged; the places.
   // Last: its places go before the map they index.
   MapLifecycle lifecycle_;

@@ -1,5 +1,6 @@
-// FrameFlow's side of the map lifecycle (slam/map_lifecycle.h): the current map's objects
-// lent to it, the localisation in a loaded map, and the replacement of a lost map.
+// FrameFlow's current map: its objects lent to the map lifecycle (slam/map_lifecycle.h) and
+// the marker world (slam/marker_world.h), the localisation in a loaded map, and the
+// replacement of a lost map.
 #include <memory>
 #include <utility>
 
@@ -11,13 +12,29 @@ MapLifecycleParts FrameFlow::Parts() {
   return {*map_, *tracker_, pose_history_, anchoring_, marker_fusion_, marker_mapping_};
 }
 
+MarkerWorldParts FrameFlow::MarkerParts() {
+  return {*map_,          *tracker_,       *mapper_,   pose_history_, anchoring_,
+          marker_fusion_, marker_mapping_, lifecycle_, *mapping_};
+}
+
+void FrameFlow::MakeLocalMapper() {
+  mapper_ = std::make_unique<LocalMapper>(*map_, options_.mapper);
+  if (options_.marker_map) {  // keyframes anchoring_ keeps are not culled
+    mapper_->SetKeyframeGuard(
+        [this](const Keyframe& keyframe) { return anchoring_.KeepsKeyframe(keyframe); });
+  }
+  if (!options_.inline_mapping && options_.yield_bundle_adjustment) {
+    mapper_->SetYieldRequest([this] { return mapping_->KeyframeWaiting(); });
+  }
+}
+
 void FrameFlow::StartFromMap(MapData map, bool world_aligned, bool localize_only) {
   lifecycle_.StartFromMap(Parts(), std::move(map), world_aligned, localize_only);
 }
 
 void FrameFlow::LocalizeInLoadedMap(Frame& frame, FrameReport& report) {
   report.state = TrackingState::kNotInitialized;
-  if (!RelocalizeWithMarkers(frame, report) &&
+  if (!marker_world_.Relocalize(MarkerParts(), frame, report) &&
       !lifecycle_.RelocalizeWithPlaces(Parts(), frame, report) &&
       !lifecycle_.RelocalizeInLoadedMap(Parts(), frame, report)) {
     report.message = "not localised in the loaded map";

@@ -26,7 +26,7 @@ struct FrameFlowOptions {
   LocalMapperOptions mapper;
   MapSessionOptions map_session;
   RadialCalibrationOptions radial_calibration;  // keypoint-only maps
-  std::optional<MarkerMap> marker_map;  // the known markers; none: keypoints only
+  std::optional<MarkerMap> marker_map;          // the known markers; none: keypoints only
   MarkerFusionOptions marker_fusion;
   WorldAnchoringOptions world_anchoring;
   OnlineMarkerMappingOptions marker_mapping;

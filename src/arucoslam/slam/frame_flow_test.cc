@@ -17,37 +17,19 @@
 
 #include "arucoslam/geometry/umeyama.h"
 #include "arucoslam/slam/synthetic_features.h"
-#include "arucoslam/slam/scripted_places.h"
+#include "arucoslam/slam/flow_test_doubles.h"
 #include "arucoslam/slam/synthetic_marker_scene.h"
 
 namespace arucoslam {
 namespace {
 
-using test_places::ScriptedPlaces;
+using test_doubles::InlineMapping;
+using test_doubles::ScriptedPlaces;
 using test_scene::kSceneDt;
 using test_scene::SceneCamera;
 using test_scene::SceneDetections;
 using test_scene::SceneMarkers;
 using test_scene::SceneWorldFromCam;
-
-// Keyframes mapped between frames, as the blocking pipeline does; counts the pauses.
-class InlineMapping final : public MappingControl {
- public:
-  bool Idle() const override { return true; }
-  bool HasRoom() const override { return true; }
-  bool Submit(KeyframeId keyframe) override {
-    pending.push_back(keyframe);
-    return false;
-  }
-  void WaitUntilMapped() override {}
-  void Pause() override { ++num_pauses; }
-  void Resume() override { ++num_resumes; }
-  bool KeyframeWaiting() const override { return false; }
-
-  std::vector<KeyframeId> pending;
-  int num_pauses = 0;
-  int num_resumes = 0;
-};
 
 // A FrameFlow, without places unless given, fed frames of the synthetic scene; with `markers` it knows the
 // scene's wall of markers and locates each frame from their detections first.

@@ -3,14 +3,13 @@
 // map reset, closed and merged into the next one, the gap bridged and a new map backfilled.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <mutex>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "arucoslam/geometry/pose_consistency.h"
 #include "arucoslam/map/map.h"
@@ -86,8 +85,7 @@ class MapLifecycle {
   std::unique_lock<std::mutex> LockPlacesForMapMove();
   // Bundle adjustment of the whole world-aligned map with every marker view (`when` is for
   // the log); mapping must be stopped and the places' edit lock free.
-  void AdjustWholeMapWithMarkers(Map& map, OnlineMarkerMapping& marker_mapping,
-                                 const char* when);
+  void AdjustWholeMapWithMarkers(Map& map, OnlineMarkerMapping& marker_mapping, const char* when);
 
   // A lost frame: true when the map must be reset now (the session's decision).
   bool OnLostFrame(const MapLifecycleParts& parts, const Frame& frame, std::size_t frame_index);

@@ -16,8 +16,7 @@ void MapLifecycle::MapInitialized(const MapLifecycleParts& parts, const InitialM
     places_->KeyframeMapped(initial.first_id);
     places_->KeyframeMapped(initial.second_id);
   }
-  session_.AddBridgePrior(initial.first_id, initial.first.timestamp_s,
-                          parts.anchoring.aligned());
+  session_.AddBridgePrior(initial.first_id, initial.first.timestamp_s, parts.anchoring.aligned());
 }
 
 bool MapLifecycle::OnLostFrame(const MapLifecycleParts& parts, const Frame& frame,

@@ -10,14 +10,14 @@
 #include <optional>
 #include <vector>
 
-#include "arucoslam/slam/scripted_places.h"
+#include "arucoslam/slam/flow_test_doubles.h"
 #include "arucoslam/slam/synthetic_marker_scene.h"
 #include "arucoslam/slam/synthetic_route_map.h"
 
 namespace arucoslam {
 namespace {
 
-using test_places::ScriptedPlaces;
+using test_doubles::ScriptedPlaces;
 
 // The objects FrameFlow lends the lifecycle, replaced on a reset as FrameFlow does; each map
 // gets a new ScriptedPlaces when `with_places`.
@@ -29,15 +29,16 @@ class LifecycleHarness {
         marker_fusion_(options_.marker_fusion, SyntheticRoute::Camera(), MarkerMap(), 0.0),
         anchoring_(options_.world_anchoring),
         marker_mapping_(options_.marker_map, options_.marker_mapping),
-        lifecycle_(options_,
-                   [this, with_places](Map&) -> std::unique_ptr<PlaceIndex> {
-                     ++num_place_indexes;
-                     if (!with_places) return nullptr;
-                     auto places = std::make_unique<ScriptedPlaces>();
-                     places_ = places.get();
-                     return places;
-                   },
-                   &stats_, &stats_mutex_) {
+        lifecycle_(
+            options_,
+            [this, with_places](Map&) -> std::unique_ptr<PlaceIndex> {
+              ++num_place_indexes;
+              if (!with_places) return nullptr;
+              auto places = std::make_unique<ScriptedPlaces>();
+              places_ = places.get();
+              return places;
+            },
+            &stats_, &stats_mutex_) {
     lifecycle_.MakePlaces(Parts());
   }
 
@@ -137,8 +138,7 @@ TEST(MapLifecycle, ALostWorldMapIsClosedAndTheNextAlignedMapMergesIt) {
   EXPECT_EQ(harness.places()->indexed.size(), 5u);
   EXPECT_EQ(session.absorbed_keyframes().count(harness.places()->indexed.front()), 1u);
   // Each keyframe once in the outputs, and in time order.
-  const std::vector<StampedPose> keyframes =
-      harness.lifecycle().KeyframePoses(harness.map(), true);
+  const std::vector<StampedPose> keyframes = harness.lifecycle().KeyframePoses(harness.map(), true);
   ASSERT_EQ(keyframes.size(), 8u);
   for (std::size_t i = 1; i < keyframes.size(); ++i) {
     EXPECT_LE(keyframes[i - 1].timestamp_s, keyframes[i].timestamp_s);

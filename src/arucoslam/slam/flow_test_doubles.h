@@ -1,5 +1,5 @@
-// ScriptedPlaces: a place database for the SLAM tests that offers the pose it is given (none:
-// nothing found) and counts what its caller does with it.
+// Test doubles of what FrameFlow and its components are given: InlineMapping (keyframes
+// mapped between frames) and ScriptedPlaces (a place database that offers a given pose).
 #pragma once
 
 #include <cstdint>
@@ -11,7 +11,30 @@
 
 #include "arucoslam/slam/place_index.h"
 
-namespace arucoslam::test_places {
+namespace arucoslam::test_doubles {
+
+// Keyframes mapped between frames, as the blocking pipeline does (the caller maps `pending`);
+// counts the pauses.
+class InlineMapping final : public MappingControl {
+ public:
+  bool Idle() const override { return true; }
+  bool HasRoom() const override { return true; }
+  bool Submit(KeyframeId keyframe) override {
+    pending.push_back(keyframe);
+    return false;
+  }
+  void WaitUntilMapped() override {}
+  void Pause() override { ++num_pauses; }
+  void Resume() override { ++num_resumes; }
+  bool KeyframeWaiting() const override { return false; }
+
+  std::vector<KeyframeId> pending;
+  int num_pauses = 0;
+  int num_resumes = 0;
+};
+
+// A place database that offers the pose it is given (none: nothing found) and counts what
+// its caller does with it.
 
 class ScriptedPlaces final : public PlaceIndex {
  public:
@@ -52,4 +75,4 @@ class ScriptedPlaces final : public PlaceIndex {
   std::mutex mutex_;
 };
 
-}  // namespace arucoslam::test_places
+}  // namespace arucoslam::test_doubles
