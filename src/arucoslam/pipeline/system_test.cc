@@ -100,6 +100,12 @@ TEST(System, OptionsCheckSaysWhichValueIsWrong) {
   options.refine_min_inlier_fraction = 1.5;
   EXPECT_FALSE(options.Check(&why));
   EXPECT_EQ(why, "refine_min_inlier_fraction must be in (0, 1], is 1.5");
+  options = {};
+  options.min_locating_marker_keyframes = -1;  // the flow's marker_mapping.min_locating_keyframes
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_EQ(why, "min_locating_marker_keyframes must be >= 0, is -1");
+  options = {};
+  options.refine_min_inlier_fraction = 1.5;
   try {
     System system(TestCamera(), options);
     ADD_FAILURE() << "no exception";

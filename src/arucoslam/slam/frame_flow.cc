@@ -1,6 +1,6 @@
 #include "arucoslam/slam/frame_flow.h"
 
-#include <algorithm>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
@@ -8,6 +8,13 @@
 
 namespace arucoslam {
 namespace {
+
+// `options`, or std::invalid_argument naming their first bad field.
+const FrameFlowOptions& Checked(const FrameFlowOptions& options) {
+  std::string why;
+  if (!options.Check(&why)) throw std::invalid_argument("FrameFlowOptions: " + why);
+  return options;
+}
 
 MarkerFusion MakeMarkerFusion(const FrameFlowOptions& options, const CameraModel& camera) {
   if (!options.marker_map) return MarkerFusion(options.marker_fusion, camera, MarkerMap(), 0.0);
@@ -21,33 +28,34 @@ MarkerFusion MakeMarkerFusion(const FrameFlowOptions& options, const CameraModel
 FrameFlow::FrameFlow(const CameraModel& camera, const FrameFlowOptions& options,
                      MappingControl* mapping, PlaceIndexFactory make_places,
                      FrameFlowStats* stats, std::mutex* stats_mutex)
-    : camera_(camera),
+    : options_(Checked(options)),
+      camera_(camera),
       tracked_camera_(camera),
       radial_calibration_(options.radial_calibration),
-      options_(options),
       mapping_(mapping),
-      make_places_(std::move(make_places)),
       stats_(stats),
       stats_mutex_(stats_mutex),
       map_initializer_(camera, options.initialization),
       pose_history_(options.refine_frame_poses,
-                    [this](KeyframeId id) { return places_ ? places_->KeyframeScale(id) : 1.0; }),
+                    [this](KeyframeId id) {
+                      const PlaceIndex* places = lifecycle_.places();
+                      return places ? places->KeyframeScale(id) : 1.0;
+                    }),
       marker_fusion_(MakeMarkerFusion(options, camera)),
       anchoring_(options.world_anchoring),
-      map_session_(options.map_session, options.marker_map.has_value()),
       marker_mapping_(options.marker_map, options.marker_mapping),
-      loaded_map_relocalizer_(options.tracker) {
+      marker_world_(options, stats, stats_mutex),
+      lifecycle_(options, std::move(make_places), stats, stats_mutex) {
   map_ = std::make_unique<Map>();
   tracker_ = std::make_unique<Tracker>(*map_, options_.tracker);
   MakeLocalMapper();
-  MakePlaces();
+  lifecycle_.MakePlaces(Parts());
 }
 
 FrameFlow::~FrameFlow() = default;
 
 void FrameFlow::CountStat(int FrameFlowStats::*counter, int amount) {
-  std::lock_guard lock(*stats_mutex_);
-  stats_->*counter += amount;
+  AddToStats(stats_, stats_mutex_, counter, amount);
 }
 
 MapPrediction FrameFlow::Prediction() const {
@@ -62,14 +70,16 @@ void FrameFlow::Process(Frame& frame, FrameReport& report) {
   FollowCalibration(frame);
   const std::optional<MarkerFix>& fix = marker_fusion_.fix();
   if (tracker_->state() == TrackingState::kNotInitialized) {
-    map_loaded_ ? LocalizeInLoadedMap(frame, report) : Initialize(frame, report);
+    lifecycle_.map_loaded() ? LocalizeInLoadedMap(frame, report) : Initialize(frame, report);
   } else {
     Track(frame, report);
   }
   // A loaded map that stays outside the marker world takes no marker-only poses.
-  const bool marker_poses = anchoring_.aligned() || !localize_only_;
-  if (!report.cam_from_world && fix && marker_poses) RecordMarkerPose(frame, report);
-  if (!localize_only_) marker_mapping_.AddMarkerView(frame, marker_fusion_.fix());
+  const bool marker_poses = anchoring_.aligned() || !localize_only();
+  if (!report.cam_from_world && fix && marker_poses) {
+    marker_world_.RecordMarkerPose(MarkerParts(), frame, report);
+  }
+  if (!localize_only()) marker_mapping_.AddMarkerView(frame, marker_fusion_.fix());
   // Without a world pose now (none, or a keypoint pose outside the world without a marker
   // location), a frame that saw markers may be located at the end.
   const bool world_pose = report.cam_from_world && (anchoring_.aligned() || fix);
@@ -92,12 +102,12 @@ void FrameFlow::Initialize(Frame& frame, FrameReport& report) {
   InitializationStep step = map_initializer_.Step(*map_, frame, marker_fusion_.fix(), report.index);
   report.message = std::move(step.message);
   if (step.attempted) CountStat(&FrameFlowStats::num_initialization_attempts);
-  if (step.for_backfill) map_session_.KeepForBackfill(*step.for_backfill);
+  if (step.for_backfill) lifecycle_.session().KeepForBackfill(*step.for_backfill);
   if (!step.map) return;
   if (step.map->in_world) {
     anchoring_.AlignedFromMarkers();  // re-aligned as anchors come
     marker_fusion_.MapEnteredWorld(frame.timestamp_s);
-    RefreshKeyframePoseCache();
+    lifecycle_.RefreshKeyframePoseCache(Parts());
     CountStat(&FrameFlowStats::num_marker_initializations);
   }
   FinishInitialization(*step.map, frame, report);
@@ -115,15 +125,10 @@ void FrameFlow::FinishInitialization(const InitialMap& initial, Frame& frame,
   pose_history_.Record(*map_, first, first_id, anchoring_.aligned(), initial.first_fix,
                        /*in_place=*/true);
   RecordPose(frame, second_id);
-  BackfillInitialization(frame, first_id, second_id);
-  if (places_) {
-    places_->KeyframeMapped(first_id);
-    places_->KeyframeMapped(second_id);
-  }
-  map_session_.AddBridgePrior(first_id, first.timestamp_s, anchoring_.aligned());
+  lifecycle_.MapInitialized(Parts(), initial, frame);
   anchoring_.AddAnchor(first_id, initial.first_fix);
   anchoring_.AddAnchor(second_id, marker_fusion_.fix());
-  MaybeAlignWorld(frame);
+  marker_world_.MaybeAlign(MarkerParts(), frame);
   frames_since_keyframe_ = 0;
   last_state_ = TrackingState::kTracking;
   report.state = TrackingState::kTracking;
@@ -139,7 +144,7 @@ void FrameFlow::FinishInitialization(const InitialMap& initial, Frame& frame,
 
 void FrameFlow::Track(Frame& frame, FrameReport& report) {
   static const std::vector<MarkerPoseObservation> kNoMarkers;
-  FollowMapCorrections();
+  lifecycle_.FollowMapCorrections(Parts());
   const std::optional<MarkerFix>& fix = marker_fusion_.fix();
   TrackingResult result =
       tracker_->Track(frame, anchoring_.aligned() && fix ? fix->markers : kNoMarkers);
@@ -152,8 +157,9 @@ void FrameFlow::Track(Frame& frame, FrameReport& report) {
   }
   bool relocalized = false;
   if (result.state != TrackingState::kTracking &&
-      (RelocalizeWithMarkers(frame, report) || RelocalizeWithPlaces(frame, report) ||
-       RelocalizeInLoadedMap(frame, report))) {
+      (marker_world_.Relocalize(MarkerParts(), frame, report) ||
+       lifecycle_.RelocalizeWithPlaces(Parts(), frame, report) ||
+       lifecycle_.RelocalizeInLoadedMap(Parts(), frame, report))) {
     result.state = TrackingState::kTracking;
     result.num_inliers = report.num_inliers;
     relocalized = true;
@@ -170,7 +176,7 @@ void FrameFlow::Track(Frame& frame, FrameReport& report) {
     return;
   }
   last_state_ = TrackingState::kTracking;
-  map_session_.OnTrackedFrame();
+  lifecycle_.session().OnTrackedFrame();
   marker_fusion_.NoteTrackedFrame(frame, relocalized, anchoring_.aligned());
   ++frames_since_keyframe_;
   MaybeInsertKeyframe(frame, result.num_inliers, report);
@@ -179,7 +185,7 @@ void FrameFlow::Track(Frame& frame, FrameReport& report) {
 }
 
 void FrameFlow::MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& report) {
-  if (localize_only_) return;
+  if (localize_only()) return;
   KeyframeDecisionInput input;
   input.frames_since_last_keyframe = frames_since_keyframe_;
   input.num_tracked = num_inliers;
@@ -216,7 +222,7 @@ void FrameFlow::MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& 
         options_.marker_map && !anchoring_.aligned() && options_.synchronous_until_aligned;
     if (young || unaligned) mapping_->WaitUntilMapped();
   }
-  MaybeAlignWorld(frame);
+  marker_world_.MaybeAlign(MarkerParts(), frame);
 }
 
 void FrameFlow::RecordPose(const Frame& frame, KeyframeId reference) {
@@ -224,25 +230,26 @@ void FrameFlow::RecordPose(const Frame& frame, KeyframeId reference) {
 }
 
 LocalMappingResult FrameFlow::MapKeyframe(KeyframeId keyframe) {
+  PlaceIndex* places = lifecycle_.places();
   std::unique_lock<std::mutex> edit;  // a loop being closed pauses local mapping
-  if (places_) edit = places_->LockMapEdits();
+  if (places) edit = places->LockMapEdits();
   marker_mapping_.AddKeyframe(*map_, keyframe);
-  CorrectDriftWithMarkers(keyframe);
+  marker_world_.CorrectDrift(*map_, keyframe, anchoring_, marker_mapping_, places);
   LocalMappingResult result = mapper_->ProcessKeyframe(keyframe);
   if (!options_.marker_map) CalibrateRadialDistortion();
-  if (places_) {
+  if (places) {
     edit.unlock();
     // Before a loop correction moves the map.
     if (options_.inline_mapping) pose_history_.ReanchorOrphans(*map_);
-    places_->KeyframeMapped(keyframe);
+    places->KeyframeMapped(keyframe);
   }
   return result;
 }
 
 void FrameFlow::Finish() {
-  if (places_) places_->Finish();
+  if (PlaceIndex* places = lifecycle_.places()) places->Finish();
   if (marker_mapping_.AdjustsWholeMap()) {
-    AdjustWholeMapWithMarkers("end of the run");
+    lifecycle_.AdjustWholeMapWithMarkers(*map_, marker_mapping_, "end of the run");
   } else {
     marker_mapping_.RefineMappedMarkers(*map_);
   }
@@ -279,41 +286,22 @@ void FrameFlow::Finish() {
 std::vector<StampedPose> FrameFlow::CheckedTrajectory(int* num_dropped) const {
   if (num_dropped != nullptr) *num_dropped = 0;
   if (const std::vector<StampedPose>* closed =
-          map_session_.BiggerClosedMapPoses(map_->NumKeyframes())) {
+          lifecycle_.session().BiggerClosedMapPoses(map_->NumKeyframes())) {
     return *closed;
   }
   std::vector<StampedPose> poses =
       pose_history_.CurrentMapPoses(*map_, /*world_only=*/options_.marker_map.has_value());
   // A loaded map's keyframes were timed in another run: they do not bracket these frames.
-  if (!options_.drop_inconsistent_poses || map_loaded_) return poses;
+  if (!options_.drop_inconsistent_poses || lifecycle_.map_loaded()) return poses;
   return DropPosesOffTheirKeyframes(poses, KeyframePoses(), options_.pose_consistency, num_dropped);
 }
 
 std::vector<StampedPose> FrameFlow::KeyframePoses() const {
-  std::vector<StampedPose> poses = map_session_.closed_keyframes();
-  if (!options_.marker_map || anchoring_.aligned()) {  // else the map is not in the world frame
-    map_->Read([&](const MapData& data) {
-      for (const auto& [id, keyframe] : data.keyframes()) {
-        poses.push_back({keyframe.timestamp_s, keyframe.cam_from_world.Inverse()});
-      }
-      return 0;
-    });
-  }
-  // Ids are not in time order once a closed map was merged (its keyframes numbered anew).
-  std::stable_sort(poses.begin(), poses.end(), [](const StampedPose& a, const StampedPose& b) {
-    return a.timestamp_s < b.timestamp_s;
-  });
-  return poses;
+  return lifecycle_.KeyframePoses(*map_, anchoring_.aligned());
 }
 
 std::vector<Eigen::Vector3d> FrameFlow::MapPoints() const {
-  std::vector<Eigen::Vector3d> points = map_session_.closed_points();
-  if (options_.marker_map && !anchoring_.aligned()) return points;  // not in the world frame
-  map_->Read([&](const MapData& data) {
-    for (const auto& [id, point] : data.map_points()) points.push_back(point.p_in_world);
-    return 0;
-  });
-  return points;
+  return lifecycle_.MapPoints(*map_, anchoring_.aligned());
 }
 
 }  // namespace arucoslam

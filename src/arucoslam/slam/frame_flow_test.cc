@@ -10,73 +10,26 @@
 #include <mutex>
 #include <optional>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "arucoslam/geometry/umeyama.h"
 #include "arucoslam/slam/synthetic_features.h"
+#include "arucoslam/slam/flow_test_doubles.h"
 #include "arucoslam/slam/synthetic_marker_scene.h"
 
 namespace arucoslam {
 namespace {
 
+using test_doubles::InlineMapping;
+using test_doubles::ScriptedPlaces;
 using test_scene::kSceneDt;
 using test_scene::SceneCamera;
 using test_scene::SceneDetections;
 using test_scene::SceneMarkers;
 using test_scene::SceneWorldFromCam;
-
-// Keyframes mapped between frames, as the blocking pipeline does; counts the pauses.
-class InlineMapping final : public MappingControl {
- public:
-  bool Idle() const override { return true; }
-  bool HasRoom() const override { return true; }
-  bool Submit(KeyframeId keyframe) override {
-    pending.push_back(keyframe);
-    return false;
-  }
-  void WaitUntilMapped() override {}
-  void Pause() override { ++num_pauses; }
-  void Resume() override { ++num_resumes; }
-  bool KeyframeWaiting() const override { return false; }
-
-  std::vector<KeyframeId> pending;
-  int num_pauses = 0;
-  int num_resumes = 0;
-};
-
-// A place database that offers the pose it is given (none: nothing found) and counts what
-// the flow does with it.
-class ScriptedPlaces final : public PlaceIndex {
- public:
-  std::optional<RelocalizationResult> Relocalize(const Frame&) override {
-    ++num_queries;
-    return offer;
-  }
-  void RelocalizationTaken() override { ++num_taken; }
-  void IndexExistingKeyframes() override {}
-  void IndexKeyframes(const std::vector<KeyframeId>&) override {}
-  void KeyframeMapped(KeyframeId) override { ++num_mapped; }
-  std::unique_lock<std::mutex> LockMapEdits() override { return std::unique_lock(mutex_); }
-  void MapMovedExternally() override {}
-  void SetMetricMap(bool) override {}
-  void SetMarkerLandmarks(MarkerLandmarks*) override {}
-  void SetBundleAdjustmentPriors(std::vector<KeyframePosePrior>) override {}
-  void SetLoopPosePriors(LoopCloser::PosePriorSource, const EssentialGraphOptions&) override {}
-  std::uint64_t corrections() const override { return 0; }
-  double KeyframeScale(KeyframeId) const override { return 1.0; }
-  void RecordScaleChanges(const std::map<KeyframeId, double>&) override {}
-  void Finish() override {}
-
-  std::optional<RelocalizationResult> offer;
-  int num_queries = 0;
-  int num_taken = 0;
-  int num_mapped = 0;
-
- private:
-  std::mutex mutex_;
-};
 
 // A FrameFlow, without places unless given, fed frames of the synthetic scene; with `markers` it knows the
 // scene's wall of markers and locates each frame from their detections first.
@@ -171,6 +124,18 @@ Sim3 TruthFromEstimate(const std::vector<StampedPose>& poses) {
       UmeyamaAlignment(estimated, truth, AlignmentKind::kSimilarity);
   EXPECT_TRUE(alignment.has_value());
   return alignment.value_or(Sim3());
+}
+
+TEST(FrameFlow, RefusesInvalidOptionsNamingTheField) {
+  FrameFlowOptions options = FlowHarness::Options(/*markers=*/true);
+  options.tracker.min_reference_matches = -1;
+  try {
+    FlowHarness harness(/*markers=*/true, options);
+    ADD_FAILURE() << "no exception";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_STREQ(error.what(),
+                 "FrameFlowOptions: tracker.min_reference_matches must be >= 0, is -1");
+  }
 }
 
 TEST(FrameFlow, KeypointsAloneInitialiseTrackAndMapTheSceneUpToScale) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -57,5 +58,12 @@ struct FrameFlowStats {
   int num_radial_calibrations = 0;   // refinements of the radial distortion applied
   double radial_k1_correction = 0.0;  // their sum: what the calibration's k1 gained
 };
+
+// Adds `amount` to one of the counts under `mutex`: other threads read them.
+inline void AddToStats(FrameFlowStats* stats, std::mutex* mutex, int FrameFlowStats::*counter,
+                       int amount = 1) {
+  std::lock_guard lock(*mutex);
+  stats->*counter += amount;
+}
 
 }  // namespace arucoslam

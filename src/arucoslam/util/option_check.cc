@@ -21,4 +21,10 @@ void OptionCheck::FailNested(std::string_view field, std::string_view nested_why
                              : fmt::format("{}.{}", field, nested_why);
 }
 
+void OptionCheck::FailAs(std::string_view reason) {
+  ok_ = false;
+  if (why_ == nullptr) return;
+  *why_ = reason.empty() ? std::string("the options fail their check") : std::string(reason);
+}
+
 }  // namespace arucoslam

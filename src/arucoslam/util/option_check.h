@@ -7,6 +7,7 @@
 //     check.AtLeast("max_iterations", max_iterations, 1);  // "max_iterations must be >= 1, is 0"
 //     check.InRange("ratio", ratio, 0.0, 1.0, Interval::kOpenClosed);  // "... in (0, 1], is 2"
 //     check.Nested("solver", solver);  // "solver.<solver's reason>"
+//     check.Unprefixed(derived);  // "<derived's reason>": its fields are named like these
 //     return check.ok();
 //   }
 //
@@ -87,6 +88,16 @@ class OptionCheck {
     return *this;
   }
 
+  // Options made from these whose fields are named alike, at this level: fails with their
+  // reason as it is.
+  template <class Options>
+  OptionCheck& Unprefixed(const Options& options) {
+    if (!ok_) return *this;
+    std::string reason;
+    if (!options.Check(why_ != nullptr ? &reason : nullptr)) FailAs(reason);
+    return *this;
+  }
+
  private:
   template <class T, class U>
   OptionCheck& Compare(bool passes, std::string_view field, const T& value, std::string_view op,
@@ -101,6 +112,7 @@ class OptionCheck {
   }
   void Fail(std::string_view field, std::string_view rule, std::string_view value);
   void FailNested(std::string_view field, std::string_view nested_why);
+  void FailAs(std::string_view reason);
 
   std::string* why_;
   bool ok_ = true;

@@ -98,6 +98,24 @@ TEST(OptionCheckTest, NestedReasonsArePrefixed) {
   EXPECT_EQ(why, "legacy fails its check");
 }
 
+TEST(OptionCheckTest, UnprefixedReasonsStayAsTheyAre) {
+  Outer outer;
+  outer.ratio = 1.5;
+  std::string why;
+  EXPECT_FALSE(OptionCheck(&why).Unprefixed(outer).ok());
+  EXPECT_EQ(why, "ratio must be in (0, 1), is 1.5");
+  outer.ratio = 0.5;
+  outer.solver.max_iterations = 0;
+  EXPECT_FALSE(OptionCheck(&why).Unprefixed(outer).ok());
+  EXPECT_EQ(why, "solver.max_iterations must be >= 1, is 0");
+  EXPECT_FALSE(OptionCheck(&why).Unprefixed(Legacy{false}).ok());
+  EXPECT_EQ(why, "the options fail their check");
+  EXPECT_TRUE(OptionCheck(&why).Unprefixed(Inner()).ok());
+  // After a failure it is not evaluated.
+  EXPECT_EQ(OptionCheck(&why).AtLeast("n", 0, 1).Unprefixed(outer).ok(), false);
+  EXPECT_EQ(why, "n must be >= 1, is 0");
+}
+
 TEST(OptionCheckTest, RuleAndRequire) {
   std::string why;
   EXPECT_FALSE(OptionCheck(&why).Rule(false, "k", 3, "even").ok());
