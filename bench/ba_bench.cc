@@ -6,6 +6,7 @@
 
 #include "arucoslam/optim/bundle_adjustment.h"
 #include "arucoslam/optim/pose_optimizer.h"
+#include "arucoslam/optim/schur_bundle_adjustment.h"
 #include "arucoslam/optim/synthetic_scene.h"
 
 namespace arucoslam {
@@ -52,6 +53,27 @@ void BM_LocalBundleAdjustment(benchmark::State& state) {
   state.counters["final_rms_px"] = summary.final_rms_px;
 }
 BENCHMARK(BM_LocalBundleAdjustment)
+    ->Args({10, 1000})
+    ->Args({20, 2000})
+    ->Unit(benchmark::kMillisecond);
+
+// The same windows solved by the explicit Schur complement (SolveBundleAdjustmentSchur).
+void BM_LocalBundleAdjustmentSchur(benchmark::State& state) {
+  const BundleAdjustmentProblem start =
+      PerturbedWindow(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  BundleAdjustmentOptions options;
+  options.max_iterations = 10;
+  BundleAdjustmentSummary summary;
+  for (auto _ : state) {
+    BundleAdjustmentProblem problem = start;
+    summary = SolveBundleAdjustmentSchur(options, &problem);
+    benchmark::DoNotOptimize(problem.poses.data());
+  }
+  state.counters["residuals"] = summary.num_residual_blocks;
+  state.counters["iterations"] = summary.num_iterations;
+  state.counters["final_rms_px"] = summary.final_rms_px;
+}
+BENCHMARK(BM_LocalBundleAdjustmentSchur)
     ->Args({10, 1000})
     ->Args({20, 2000})
     ->Unit(benchmark::kMillisecond);
