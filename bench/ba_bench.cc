@@ -19,22 +19,7 @@ BundleAdjustmentProblem PerturbedWindow(int num_poses, int num_points) {
   options.num_poses = num_poses;
   options.num_points = num_points;
   options.noise_px = 0.5;
-  BundleAdjustmentProblem problem = MakeSyntheticScene(options);
-  std::mt19937 random(7);
-  std::normal_distribution<double> normal(0.0, 1.0);
-  for (std::size_t i = 0; i < problem.poses.size(); ++i) {
-    if (i < 2) {
-      problem.poses[i].fixed = true;
-      continue;
-    }
-    Vector6d delta;
-    for (int k = 0; k < 6; ++k) delta[k] = 0.02 * normal(random);
-    problem.poses[i].cam_from_world = Rigid3::Exp(delta) * problem.poses[i].cam_from_world;
-  }
-  for (auto& point : problem.points) {
-    point.p_in_world += 0.1 * Eigen::Vector3d(normal(random), normal(random), normal(random));
-  }
-  return problem;
+  return PerturbedScene(MakeSyntheticScene(options), 7);
 }
 
 void BM_LocalBundleAdjustment(benchmark::State& state) {

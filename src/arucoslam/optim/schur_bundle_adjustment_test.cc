@@ -2,8 +2,6 @@
 
 #include <gtest/gtest.h>
 
-#include <random>
-
 #include "arucoslam/optim/synthetic_scene.h"
 
 namespace arucoslam {
@@ -17,22 +15,7 @@ BundleAdjustmentProblem PerturbedWindow(int num_poses, int num_points, std::uint
   scene.num_points = num_points;
   scene.noise_px = 0.5;
   scene.seed = seed;
-  BundleAdjustmentProblem problem = MakeSyntheticScene(scene);
-  std::mt19937 random(seed + 100);
-  std::normal_distribution<double> normal(0.0, 1.0);
-  for (std::size_t i = 0; i < problem.poses.size(); ++i) {
-    if (i < 2) {
-      problem.poses[i].fixed = true;
-      continue;
-    }
-    Vector6d delta;
-    for (int k = 0; k < 6; ++k) delta[k] = 0.02 * normal(random);
-    problem.poses[i].cam_from_world = Rigid3::Exp(delta) * problem.poses[i].cam_from_world;
-  }
-  for (auto& point : problem.points) {
-    point.p_in_world += 0.1 * Eigen::Vector3d(normal(random), normal(random), normal(random));
-  }
-  return problem;
+  return PerturbedScene(MakeSyntheticScene(scene), seed + 100);
 }
 
 double MaxCentreDistance(const BundleAdjustmentProblem& a, const BundleAdjustmentProblem& b) {
