@@ -1,4 +1,5 @@
-#include "arucoslam/optim/schur_bundle_adjustment.h"
+// SolveBundleAdjustment: Levenberg-Marquardt with an explicit Schur complement over the points.
+#include "arucoslam/optim/bundle_adjustment.h"
 
 #include <Eigen/Cholesky>
 #include <algorithm>
@@ -272,8 +273,8 @@ double GradientMaxNorm(const NormalEquations& equations, const Layout& layout) {
 
 }  // namespace
 
-BundleAdjustmentSummary SolveBundleAdjustmentSchur(const BundleAdjustmentOptions& options,
-                                                   BundleAdjustmentProblem* problem) {
+BundleAdjustmentSummary SolveBundleAdjustment(const BundleAdjustmentOptions& options,
+                                              BundleAdjustmentProblem* problem) {
   BundleAdjustmentSummary summary;
   std::string reason;
   if (!options.Check()) {
