@@ -81,18 +81,8 @@ struct BundleAdjustmentSummary {
 
 // Solves in place. Poses that no observation touches are left unchanged. When no pose is
 // fixed the gauge is free: fix at least one pose (and for monocular two, or accept scale drift).
-// Levenberg-Marquardt with the points eliminated by an explicit Schur complement
-// (schur_bundle_adjustment.cc): Huber reweighted as Ceres corrects a loss with no curvature,
-// points behind a camera contributing nothing, Ceres' trust-region rule; the reduced system
-// over the free poses is dense and solved by Cholesky. `num_iterations` counts the steps
-// tried, accepted or not, as Ceres does.
 BundleAdjustmentSummary SolveBundleAdjustment(const BundleAdjustmentOptions& options,
                                               BundleAdjustmentProblem* problem);
-
-// The same solve by Ceres (dense Schur): the reference the tests hold SolveBundleAdjustment
-// to, and the plain half of the radial calibration's pair of Ceres solves.
-BundleAdjustmentSummary SolveBundleAdjustmentWithCeres(const BundleAdjustmentOptions& options,
-                                                       BundleAdjustmentProblem* problem);
 
 // Reprojection RMS in pixels over all observations in front of their camera.
 double ReprojectionRmsPixels(const BundleAdjustmentProblem& problem);

@@ -1,4 +1,4 @@
-// The Ceres side of SolveBundleAdjustmentWithCeres and SolveBundleAdjustmentWithRadialTerm: an SE(3)
+// The Ceres side of SolveBundleAdjustment and SolveBundleAdjustmentWithRadialTerm: an SE(3)
 // manifold for poses stored as [qx qy qz qw tx ty tz] and analytic reprojection costs
 // (ReprojectionError, with or without the shared radial coefficient).
 #include <ceres/ceres.h>
@@ -142,8 +142,8 @@ BundleAdjustmentSummary Solve(const BundleAdjustmentOptions& options,
 
 }  // namespace
 
-BundleAdjustmentSummary SolveBundleAdjustmentWithCeres(const BundleAdjustmentOptions& options,
-                                                       BundleAdjustmentProblem* problem) {
+BundleAdjustmentSummary SolveBundleAdjustment(const BundleAdjustmentOptions& options,
+                                              BundleAdjustmentProblem* problem) {
   return Solve(options, problem, nullptr);
 }
 

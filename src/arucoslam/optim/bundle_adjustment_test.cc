@@ -36,6 +36,28 @@ Errors Compare(const BundleAdjustmentProblem& estimate, const BundleAdjustmentPr
   return errors;
 }
 
+// Perturbs every pose but the first two (which fix the gauge and the scale) and every point.
+BundleAdjustmentProblem Perturb(const BundleAdjustmentProblem& truth, std::uint32_t seed,
+                                double pose_sigma, double point_sigma) {
+  std::mt19937 random(seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  BundleAdjustmentProblem problem = truth;
+  for (std::size_t i = 0; i < problem.poses.size(); ++i) {
+    if (i < 2) {
+      problem.poses[i].fixed = true;
+      continue;
+    }
+    Vector6d delta;
+    for (int k = 0; k < 6; ++k) delta[k] = pose_sigma * normal(random);
+    problem.poses[i].cam_from_world = Rigid3::Exp(delta) * problem.poses[i].cam_from_world;
+  }
+  for (auto& point : problem.points) {
+    point.p_in_world +=
+        point_sigma * Eigen::Vector3d(normal(random), normal(random), normal(random));
+  }
+  return problem;
+}
+
 TEST(BundleAdjustmentTest, OptionsAndProblemChecks) {
   EXPECT_TRUE(BundleAdjustmentOptions{}.Check());
   BundleAdjustmentOptions options;
@@ -81,7 +103,7 @@ TEST(BundleAdjustmentTest, PerturbedSceneConvergesToTruth) {
   scene_options.noise_px = 0.5;
   const BundleAdjustmentProblem truth = MakeSyntheticScene(scene_options);
   ASSERT_GT(truth.observations.size(), 5000u);
-  BundleAdjustmentProblem problem = PerturbedScene(truth, 7, 0.02, 0.1);
+  BundleAdjustmentProblem problem = Perturb(truth, 7, 0.02, 0.1);
   const Errors before = Compare(problem, truth);
 
   const BundleAdjustmentSummary summary = SolveBundleAdjustment({}, &problem);
@@ -114,7 +136,7 @@ TEST(BundleAdjustmentTest, StopRequestEndsTheSolveWithAUsableIterate) {
   SyntheticSceneOptions scene_options;
   scene_options.noise_px = 0.5;
   const BundleAdjustmentProblem truth = MakeSyntheticScene(scene_options);
-  const BundleAdjustmentProblem start = PerturbedScene(truth, 7, 0.02, 0.1);
+  const BundleAdjustmentProblem start = Perturb(truth, 7, 0.02, 0.1);
   BundleAdjustmentProblem full = start;
   BundleAdjustmentProblem stopped = start;
   const BundleAdjustmentSummary full_summary = SolveBundleAdjustment({}, &full);
@@ -153,7 +175,7 @@ TEST(BundleAdjustmentTest, HuberLossResistsOutliersAndFlagsThem) {
   SyntheticSceneOptions scene_options;
   scene_options.noise_px = 0.5;
   const BundleAdjustmentProblem truth = MakeSyntheticScene(scene_options);
-  BundleAdjustmentProblem problem = PerturbedScene(truth, 8, 0.01, 0.05);
+  BundleAdjustmentProblem problem = Perturb(truth, 8, 0.01, 0.05);
   // Move every 50th observation 30 px away: gross mismatches.
   std::vector<bool> corrupted(problem.observations.size(), false);
   for (std::size_t k = 0; k < problem.observations.size(); k += 50) {

@@ -64,25 +64,4 @@ BundleAdjustmentProblem MakeSyntheticScene(const SyntheticSceneOptions& options)
   return problem;
 }
 
-BundleAdjustmentProblem PerturbedScene(const BundleAdjustmentProblem& scene, std::uint32_t seed,
-                                       double pose_sigma, double point_sigma) {
-  BundleAdjustmentProblem problem = scene;
-  std::mt19937 random(seed);
-  std::normal_distribution<double> normal(0.0, 1.0);
-  for (std::size_t i = 0; i < problem.poses.size(); ++i) {
-    if (i < 2) {
-      problem.poses[i].fixed = true;
-      continue;
-    }
-    Vector6d delta;
-    for (int k = 0; k < 6; ++k) delta[k] = pose_sigma * normal(random);
-    problem.poses[i].cam_from_world = Rigid3::Exp(delta) * problem.poses[i].cam_from_world;
-  }
-  for (auto& point : problem.points) {
-    point.p_in_world +=
-        point_sigma * Eigen::Vector3d(normal(random), normal(random), normal(random));
-  }
-  return problem;
-}
-
 }  // namespace arucoslam

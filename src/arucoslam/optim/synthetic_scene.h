@@ -28,10 +28,4 @@ struct SyntheticSceneOptions {
 // sigma_px = 1, so whitened residuals are pixel residuals. Deterministic for a seed.
 BundleAdjustmentProblem MakeSyntheticScene(const SyntheticSceneOptions& options);
 
-// `scene` as a solver starts from it: the first two poses fixed (the gauge and the scale),
-// every other pose moved by about `pose_sigma` (tangent units) and every point by about
-// `point_sigma` metres, Gaussian. Deterministic for a seed.
-BundleAdjustmentProblem PerturbedScene(const BundleAdjustmentProblem& scene, std::uint32_t seed,
-                                       double pose_sigma = 0.02, double point_sigma = 0.1);
-
 }  // namespace arucoslam

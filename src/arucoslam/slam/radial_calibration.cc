@@ -32,8 +32,7 @@ RadialCalibrationStep RadialCalibration::MaybeRefine(Map& map, CameraModel* came
   GlobalBundleAdjustmentSnapshot plain =
       map.Read([&](const MapData& data) { return TakeGlobalSnapshot(data, global); });
   GlobalBundleAdjustmentSnapshot radial = plain;
-  const BundleAdjustmentSummary without =
-      SolveBundleAdjustmentWithCeres(options_.solver, &plain.problem);
+  const BundleAdjustmentSummary without = SolveBundleAdjustment(options_.solver, &plain.problem);
   const RadialRefinementSummary with =
       SolveBundleAdjustmentWithRadialTerm(options_.solver, &radial.problem);
   step.k = with.k;
