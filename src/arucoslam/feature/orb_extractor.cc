@@ -144,6 +144,8 @@ struct CellGrid {
 
   int CellX(int x) const { return (x - region.x) / cell_size; }
   int CellY(int y) const { return (y - region.y) / cell_size; }
+  // Corners of the initial threshold in the cell holding level pixel p.
+  int& CountAt(const cv::Point& p) { return corner_counts[CellY(p.y) * cells_x + CellX(p.x)]; }
   bool Empty(int cx, int cy) const { return corner_counts[cy * cells_x + cx] == 0; }
   // Cells [cx_begin, cx_end) of row cy as one rectangle.
   cv::Rect Cells(int cx_begin, int cx_end, int cy) const {
@@ -231,7 +233,7 @@ void DetectStrongCorners(const cv::Mat& image, int threshold, CellGrid& grid,
       ScoredCandidates(image, grid.region, threshold, scores);
   for (const cv::Point& pixel : candidates) {
     if (!scores.StrongestAround(pixel, grid.region.x, grid.region.br().x)) continue;
-    ++grid.corner_counts[grid.CellY(pixel.y) * grid.cells_x + grid.CellX(pixel.x)];
+    ++grid.CountAt(pixel);
     corners.push_back(FastKeypoint(pixel, scores.At(pixel)));
   }
 }
