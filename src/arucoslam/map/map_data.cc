@@ -8,34 +8,22 @@
 
 namespace arucoslam {
 
-Keyframe* MapData::MutableKeyframe(KeyframeId id) {
-  const auto it = keyframes_.find(id);
-  return it == keyframes_.end() ? nullptr : &it->second;
-}
+Keyframe* MapData::MutableKeyframe(KeyframeId id) { return keyframes_.Find(id); }
 
-MapPoint* MapData::MutableMapPoint(MapPointId id) {
-  const auto it = points_.find(id);
-  return it == points_.end() ? nullptr : &it->second;
-}
+MapPoint* MapData::MutableMapPoint(MapPointId id) { return points_.Find(id); }
 
-const Keyframe* MapData::FindKeyframe(KeyframeId id) const {
-  const auto it = keyframes_.find(id);
-  return it == keyframes_.end() ? nullptr : &it->second;
-}
+const Keyframe* MapData::FindKeyframe(KeyframeId id) const { return keyframes_.Find(id); }
 
-const MapPoint* MapData::FindMapPoint(MapPointId id) const {
-  const auto it = points_.find(id);
-  return it == points_.end() ? nullptr : &it->second;
-}
+const MapPoint* MapData::FindMapPoint(MapPointId id) const { return points_.Find(id); }
 
 KeyframeId MapData::AddKeyframe(Keyframe keyframe, KeyframeId parent_hint) {
   const KeyframeId id = keyframe_ids_.Next();
   keyframe.id = id;
   std::vector<MapPointId> wanted = std::move(keyframe.map_point_ids);
   keyframe.map_point_ids.assign(keyframe.features.size(), MapPointId());
-  keyframes_.emplace(id, std::move(keyframe));
+  const std::size_t num_keypoints = keyframes_.Emplace(id, std::move(keyframe)).map_point_ids.size();
   graph_.AddKeyframe(id);
-  for (std::size_t i = 0; i < wanted.size() && i < keyframes_[id].map_point_ids.size(); ++i) {
+  for (std::size_t i = 0; i < wanted.size() && i < num_keypoints; ++i) {
     const MapPoint* point = FindMapPoint(wanted[i]);
     if (point == nullptr || point->observations.count(id) != 0) continue;
     AddObservation(id, static_cast<int>(i), wanted[i]);
@@ -58,16 +46,16 @@ KeyframeId MapData::AddKeyframe(Keyframe keyframe, KeyframeId parent_hint) {
 bool MapData::Absorb(const MapData& other, KeyframeId attach_to, AbsorbedIds* ids) {
   if (!graph_.Contains(attach_to)) return false;
   *ids = AbsorbedIds();
-  for (const auto& [old_id, source] : other.keyframes_) {
+  for (const auto& [old_id, source] : other.keyframes_.map()) {
     Keyframe keyframe = source;
     const KeyframeId id = keyframe_ids_.Next();
     keyframe.id = id;
     keyframe.map_point_ids.assign(keyframe.features.size(), MapPointId());
-    keyframes_.emplace(id, std::move(keyframe));
+    keyframes_.Emplace(id, std::move(keyframe));
     graph_.AddKeyframe(id);
     ids->keyframes[old_id] = id;
   }
-  for (const auto& [old_id, source] : other.points_) {
+  for (const auto& [old_id, source] : other.points_.map()) {
     const MapPointId id = AddMapPoint(source);
     ids->points[old_id] = id;
     for (const auto& [keyframe, index] : source.observations) {
@@ -75,7 +63,7 @@ bool MapData::Absorb(const MapData& other, KeyframeId attach_to, AbsorbedIds* id
     }
     // The reference is an id of `other`: the same number may name a keyframe of this map,
     // whose corrections the point would then follow.
-    MapPoint& point = points_.at(id);
+    MapPoint& point = *points_.Find(id);
     const auto reference = ids->keyframes.find(source.reference_keyframe);
     if (reference != ids->keyframes.end()) {
       point.reference_keyframe = reference->second;
@@ -95,7 +83,7 @@ MapPointId MapData::AddMapPoint(MapPoint point) {
   const MapPointId id = point_ids_.Next();
   point.id = id;
   point.observations.clear();
-  points_.emplace(id, std::move(point));
+  points_.Emplace(id, std::move(point));
   return id;
 }
 
@@ -139,7 +127,7 @@ void MapData::EraseMapPoint(MapPointId point_id) {
   while (!point->observations.empty()) {
     EraseObservation(point->observations.begin()->first, point_id);
   }
-  points_.erase(point_id);
+  points_.Erase(point_id);
 }
 
 bool MapData::EraseKeyframe(KeyframeId keyframe_id) {
@@ -149,11 +137,11 @@ bool MapData::EraseKeyframe(KeyframeId keyframe_id) {
   for (const MapPointId& point_id : observed) {
     EraseObservation(keyframe_id, point_id);
     const MapPoint* point = FindMapPoint(point_id);
-    if (point != nullptr && point->observations.empty()) points_.erase(point_id);
+    if (point != nullptr && point->observations.empty()) points_.Erase(point_id);
   }
   graph_.RemoveKeyframe(keyframe_id);
-  keyframes_.erase(keyframe_id);
-  if (last_keyframe_ == keyframe_id) last_keyframe_ = keyframes_.rbegin()->first;
+  keyframes_.Erase(keyframe_id);
+  if (last_keyframe_ == keyframe_id) last_keyframe_ = keyframes_.map().rbegin()->first;
   return true;
 }
 
@@ -203,7 +191,8 @@ void MapData::UpdateDescriptor(MapPointId id) {
 }
 
 void MapData::RecalibrateKeyframes(const CameraModel& camera) {
-  for (auto& [id, keyframe] : keyframes_) {
+  for (const auto& [id, unused] : keyframes_.map()) {
+    Keyframe& keyframe = *keyframes_.Find(id);
     keyframe.camera = camera;
     UndistortFeatures(camera, &keyframe.features);
   }

@@ -7,6 +7,7 @@
 
 #include "arucoslam/map/covisibility_graph.h"
 #include "arucoslam/map/frame.h"
+#include "arucoslam/map/indexed_map.h"
 #include "arucoslam/map/map_point.h"
 #include "arucoslam/util/ids.h"
 
@@ -72,8 +73,8 @@ class MapData {
 
   const Keyframe* FindKeyframe(KeyframeId id) const;
   const MapPoint* FindMapPoint(MapPointId id) const;
-  const std::map<KeyframeId, Keyframe>& keyframes() const { return keyframes_; }
-  const std::map<MapPointId, MapPoint>& map_points() const { return points_; }
+  const std::map<KeyframeId, Keyframe>& keyframes() const { return keyframes_.map(); }
+  const std::map<MapPointId, MapPoint>& map_points() const { return points_.map(); }
   const CovisibilityGraph& covisibility() const { return graph_; }
   std::size_t NumKeyframes() const { return keyframes_.size(); }
   std::size_t NumMapPoints() const { return points_.size(); }
@@ -90,8 +91,8 @@ class MapData {
   Keyframe* MutableKeyframe(KeyframeId id);
   MapPoint* MutableMapPoint(MapPointId id);
 
-  std::map<KeyframeId, Keyframe> keyframes_;
-  std::map<MapPointId, MapPoint> points_;
+  IndexedMap<KeyframeId, Keyframe> keyframes_;
+  IndexedMap<MapPointId, MapPoint> points_;
   CovisibilityGraph graph_;
   IdGenerator<KeyframeId> keyframe_ids_;
   IdGenerator<MapPointId> point_ids_;

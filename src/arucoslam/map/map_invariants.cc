@@ -12,7 +12,7 @@ namespace arucoslam {
 
 std::string MapData::CheckInvariants() const {
   // Keyframe slots -> point observations.
-  for (const auto& [keyframe_id, keyframe] : keyframes_) {
+  for (const auto& [keyframe_id, keyframe] : keyframes_.map()) {
     if (keyframe.id != keyframe_id) return fmt::format("keyframe {}: wrong id", keyframe_id.value);
     for (std::size_t i = 0; i < keyframe.map_point_ids.size(); ++i) {
       const MapPointId point_id = keyframe.map_point_ids[i];
@@ -31,7 +31,7 @@ std::string MapData::CheckInvariants() const {
   }
   // Point observations -> keyframe slots; recount the covisibility weights.
   std::map<std::pair<KeyframeId, KeyframeId>, int> shared;
-  for (const auto& [point_id, point] : points_) {
+  for (const auto& [point_id, point] : points_.map()) {
     for (const auto& [keyframe_id, index] : point.observations) {
       const Keyframe* keyframe = FindKeyframe(keyframe_id);
       if (keyframe == nullptr || index < 0 ||
@@ -45,7 +45,7 @@ std::string MapData::CheckInvariants() const {
       }
     }
   }
-  for (const auto& [keyframe_id, keyframe] : keyframes_) {
+  for (const auto& [keyframe_id, keyframe] : keyframes_.map()) {
     if (!graph_.Contains(keyframe_id)) {
       return fmt::format("keyframe {}: not in the graph", keyframe_id.value);
     }

@@ -1,7 +1,8 @@
 // LocalMapper::FuseDuplicates: the new keyframe's points are projected into its covisible
 // keyframes and theirs into it; a match on a keypoint that already has a point merges the two
 // (the one with more observations is kept), a match on a free keypoint adds an observation.
-#include <set>
+#include <algorithm>
+#include <vector>
 
 #include "arucoslam/feature/feature_grid.h"
 #include "arucoslam/slam/local_mapper.h"
@@ -50,15 +51,17 @@ int LocalMapper::FuseDuplicates(KeyframeId keyframe) {
     const Keyframe* current = data.FindKeyframe(keyframe);
     if (current == nullptr) return;
     const std::vector<MapPointId> own_points = data.MapPointsOf(keyframe);
-    std::set<MapPointId> their_points;
+    std::vector<MapPointId> their_points;
     for (const KeyframeId& id :
          data.covisibility().BestCovisible(keyframe, options_.fusion_neighbours)) {
       const Keyframe& target = *data.FindKeyframe(id);
       ProjectAndMatch(data, target, own_points, options_, &actions);
-      for (const MapPointId& point : data.MapPointsOf(id)) their_points.insert(point);
+      const std::vector<MapPointId> points = data.MapPointsOf(id);
+      their_points.insert(their_points.end(), points.begin(), points.end());
     }
-    ProjectAndMatch(data, *current, {their_points.begin(), their_points.end()}, options_,
-                    &actions);
+    std::sort(their_points.begin(), their_points.end());
+    their_points.erase(std::unique(their_points.begin(), their_points.end()), their_points.end());
+    ProjectAndMatch(data, *current, their_points, options_, &actions);
   });
   return map_.Write([&](MapData& data) {
     int fused = 0;

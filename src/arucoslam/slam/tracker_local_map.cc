@@ -2,8 +2,9 @@
 // best covisible neighbours), their points projected into the frame and matched, then the
 // final pose optimisation.
 #include <algorithm>
-#include <map>
 #include <set>
+#include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "arucoslam/feature/feature_grid.h"
@@ -17,7 +18,7 @@ namespace {
 // neighbours of each; the first one is the frame's natural reference keyframe.
 std::vector<KeyframeId> LocalKeyframes(const MapData& data, const std::vector<MapPointId>& voters,
                                        const TrackerOptions& options) {
-  std::map<KeyframeId, int> votes;
+  std::unordered_map<KeyframeId, int> votes;
   for (const MapPointId& id : voters) {
     if (const MapPoint* point = data.FindMapPoint(id)) {
       for (const auto& [keyframe, index] : point->observations) ++votes[keyframe];
@@ -50,7 +51,7 @@ ProjectionQueries LocalPointQueries(const MapData& data, const Frame& frame,
                                     const std::vector<KeyframeId>& local,
                                     const TrackerOptions& options, double radius_factor,
                                     std::vector<MapPointId>* visible) {
-  std::set<MapPointId> matched;
+  std::unordered_set<MapPointId> matched;
   for (const MapPointId& id : frame.map_point_ids) {
     if (id.IsValid()) {
       matched.insert(id);
@@ -59,7 +60,8 @@ ProjectionQueries LocalPointQueries(const MapData& data, const Frame& frame,
   }
   const Rigid3& cam_from_world = *frame.cam_from_world;
   const Eigen::Vector3d center = cam_from_world.Inverse().translation;
-  std::set<MapPointId> seen;
+  std::unordered_set<MapPointId> seen;
+  seen.reserve(4 * frame.map_point_ids.size());
   ProjectionQueries set;
   for (const KeyframeId& keyframe : local) {
     for (const MapPointId& id : data.MapPointsOf(keyframe)) {
