@@ -80,25 +80,37 @@ const std::map<KeyframeId, int>& CovisibilityGraph::Neighbours(KeyframeId id) co
   return it == nodes_.end() ? kEmpty : it->second.weights;
 }
 
-std::vector<KeyframeId> CovisibilityGraph::CovisibleWithMinWeight(KeyframeId id,
-                                                                  int min_weight) const {
+namespace {
+
+// The first `n` neighbours of weight `min_weight` or more, heaviest first, ties by id.
+std::vector<KeyframeId> HeaviestNeighbours(const std::map<KeyframeId, int>& neighbours,
+                                           int min_weight, std::size_t n) {
   std::vector<std::pair<int, KeyframeId>> sorted;
-  for (const auto& [neighbour, weight] : Neighbours(id)) {
+  sorted.reserve(neighbours.size());
+  for (const auto& [neighbour, weight] : neighbours) {
     if (weight >= min_weight) sorted.emplace_back(weight, neighbour);
   }
-  std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) {
+  const auto heavier = [](const auto& a, const auto& b) {
     return a.first != b.first ? a.first > b.first : a.second < b.second;
-  });
+  };
+  n = std::min(n, sorted.size());
+  std::partial_sort(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(n),
+                    sorted.end(), heavier);
   std::vector<KeyframeId> result;
-  result.reserve(sorted.size());
-  for (const auto& entry : sorted) result.push_back(entry.second);
+  result.reserve(n);
+  for (std::size_t k = 0; k < n; ++k) result.push_back(sorted[k].second);
   return result;
 }
 
+}  // namespace
+
+std::vector<KeyframeId> CovisibilityGraph::CovisibleWithMinWeight(KeyframeId id,
+                                                                  int min_weight) const {
+  return HeaviestNeighbours(Neighbours(id), min_weight, Neighbours(id).size());
+}
+
 std::vector<KeyframeId> CovisibilityGraph::BestCovisible(KeyframeId id, int n) const {
-  std::vector<KeyframeId> result = CovisibleWithMinWeight(id, 1);
-  if (static_cast<int>(result.size()) > n) result.resize(std::max(n, 0));
-  return result;
+  return HeaviestNeighbours(Neighbours(id), 1, static_cast<std::size_t>(std::max(n, 0)));
 }
 
 KeyframeId CovisibilityGraph::Parent(KeyframeId id) const {

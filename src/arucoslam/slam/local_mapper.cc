@@ -129,6 +129,15 @@ bool IsRedundant(const MapData& data, const Keyframe& candidate, double fraction
   return num_points > 0 && num_redundant > needed;
 }
 
+// Whether `keyframe` observes fewer than `n` map points (stops counting at n).
+bool HasFewerMapPoints(const Keyframe& keyframe, int n) {
+  int count = 0;
+  for (const MapPointId& id : keyframe.map_point_ids) {
+    if (id.IsValid() && ++count >= n) return false;
+  }
+  return count < n;
+}
+
 int NumMapPoints(const Keyframe& keyframe) {
   return static_cast<int>(std::count_if(keyframe.map_point_ids.begin(),
                                         keyframe.map_point_ids.end(),
@@ -162,7 +171,7 @@ int LocalMapper::CullRedundantKeyframes(KeyframeId keyframe) {
     }
     // Keyframes that lost their points need not be covisible with anything any more.
     for (const auto& [id, candidate] : data.keyframes()) {
-      if (older(id) && NumMapPoints(candidate) < options_.min_keyframe_points &&
+      if (older(id) && HasFewerMapPoints(candidate, options_.min_keyframe_points) &&
           std::find(candidates.begin(), candidates.end(), id) == candidates.end()) {
         candidates.push_back(id);
       }

@@ -2,9 +2,9 @@
 // best covisible neighbours), their points projected into the frame and matched, then the
 // final pose optimisation.
 #include <algorithm>
+#include <cstdint>
 #include <set>
 #include <unordered_map>
-#include <unordered_set>
 #include <vector>
 
 #include "arucoslam/feature/feature_grid.h"
@@ -45,27 +45,50 @@ std::vector<KeyframeId> LocalKeyframes(const MapData& data, const std::vector<Ma
   return local;
 }
 
+// Marks on map point ids (dense integers from the map's IdGenerator): a set with constant-time
+// insertion that clears in the time of its insertions. One per thread, reused across frames.
+class PointMarks {
+ public:
+  // True when `id` was not marked yet (it is now).
+  bool Insert(MapPointId id) {
+    if (id.value >= marked_.size()) marked_.resize(id.value + 1 + id.value / 2, 0);
+    if (marked_[id.value] != 0) return false;
+    marked_[id.value] = 1;
+    inserted_.push_back(id.value);
+    return true;
+  }
+  bool Contains(MapPointId id) const { return id.value < marked_.size() && marked_[id.value] != 0; }
+  void Clear() {
+    for (const auto value : inserted_) marked_[value] = 0;
+    inserted_.clear();
+  }
+
+ private:
+  std::vector<std::uint8_t> marked_;
+  std::vector<MapPointId::ValueType> inserted_;
+};
+
 // Projects the local points that the frame has not matched yet; returns the queries and
 // (through `visible`) every point predicted in view, matched ones included.
 ProjectionQueries LocalPointQueries(const MapData& data, const Frame& frame,
                                     const std::vector<KeyframeId>& local,
                                     const TrackerOptions& options, double radius_factor,
                                     std::vector<MapPointId>* visible) {
-  std::unordered_set<MapPointId> matched;
+  // Points already matched or already considered: skipped.
+  thread_local PointMarks done;
+  done.Clear();
   for (const MapPointId& id : frame.map_point_ids) {
     if (id.IsValid()) {
-      matched.insert(id);
+      done.Insert(id);
       visible->push_back(id);
     }
   }
   const Rigid3& cam_from_world = *frame.cam_from_world;
   const Eigen::Vector3d center = cam_from_world.Inverse().translation;
-  std::unordered_set<MapPointId> seen;
-  seen.reserve(4 * frame.map_point_ids.size());
   ProjectionQueries set;
   for (const KeyframeId& keyframe : local) {
-    for (const MapPointId& id : data.MapPointsOf(keyframe)) {
-      if (matched.count(id) != 0 || !seen.insert(id).second) continue;
+    for (const MapPointId& id : data.FindKeyframe(keyframe)->map_point_ids) {
+      if (!id.IsValid() || !done.Insert(id)) continue;
       const MapPoint& point = *data.FindMapPoint(id);
       const std::optional<Eigen::Vector2d> pixel =
           frame.camera.Project(cam_from_world * point.p_in_world);
