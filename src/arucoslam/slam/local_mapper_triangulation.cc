@@ -33,13 +33,9 @@ std::vector<FeatureMatch> MatchAlongEpipolarLines(const Keyframe& kf1, const Key
   const Eigen::Vector2d epipole = has_epipole ? Eigen::Vector2d(t.x() / t.z(), t.y() / t.z())
                                               : Eigen::Vector2d::Zero();
   // The unmatched keypoints of kf2 away from the epipole, with their epipolar band: what
-  // the inner loop needs, packed, in kf2's keypoint order.
-  struct Candidate {
-    Eigen::Vector3d x2;            // undistorted, homogeneous
-    double max_distance2_px = 0.0; // epipolar_chi2 x sigma^2
-    int index = 0;
-  };
-  std::vector<Candidate> candidates;
+  // the inner loop needs, packed column-wise in kf2's keypoint order so that the band test
+  // runs over all of them in vector instructions.
+  std::vector<int> candidates;
   for (std::size_t j = 0; j < kf2.map_point_ids.size(); ++j) {
     if (kf2.map_point_ids[j].IsValid()) continue;
     const int index = static_cast<int>(j);
@@ -48,8 +44,17 @@ std::vector<FeatureMatch> MatchAlongEpipolarLines(const Keyframe& kf1, const Key
                            options.min_epipole_distance_px * kf2.SigmaPx(index)) {
       continue;
     }
-    candidates.push_back({x2.homogeneous(), options.epipolar_chi2 * Sigma2(kf2, index), index});
+    candidates.push_back(index);
   }
+  const Eigen::Index num_candidates = static_cast<Eigen::Index>(candidates.size());
+  Eigen::ArrayXd x2s(num_candidates), y2s(num_candidates), max_distance2_px(num_candidates);
+  for (Eigen::Index k = 0; k < num_candidates; ++k) {
+    const Eigen::Vector2d& x2 = kf2.features.undistorted[candidates[k]];
+    x2s[k] = x2.x();
+    y2s[k] = x2.y();
+    max_distance2_px[k] = options.epipolar_chi2 * Sigma2(kf2, candidates[k]);
+  }
+  Eigen::ArrayXd distance2_px(num_candidates);  // squared distance to the line, pixels
   std::vector<int> best_for_2(kf2.features.size(), -1);
   std::vector<int> best_distance_2(kf2.features.size(), std::numeric_limits<int>::max());
   for (std::size_t i = 0; i < kf1.map_point_ids.size(); ++i) {
@@ -57,16 +62,17 @@ std::vector<FeatureMatch> MatchAlongEpipolarLines(const Keyframe& kf1, const Key
     const Eigen::Vector3d line = essential * kf1.features.undistorted[i].homogeneous();
     const double norm2 = line.head<2>().squaredNorm();
     if (norm2 <= 0.0) continue;
+    distance2_px = (line.x() * x2s + line.y() * y2s + line.z()).square() / norm2 * focal2 * focal2;
     const std::uint8_t* descriptor1 = kf1.features.Descriptor(static_cast<int>(i));
     int best = -1, best_distance = options.max_match_distance + 1, second = 256;
-    for (const Candidate& candidate : candidates) {
-      const double along = line.dot(candidate.x2);
-      if (along * along / norm2 * focal2 * focal2 > candidate.max_distance2_px) continue;
-      const int distance = HammingDistance(descriptor1, kf2.features.Descriptor(candidate.index));
+    for (Eigen::Index k = 0; k < num_candidates; ++k) {
+      if (distance2_px[k] > max_distance2_px[k]) continue;
+      const int candidate = candidates[k];
+      const int distance = HammingDistance(descriptor1, kf2.features.Descriptor(candidate));
       if (distance < best_distance) {
         second = best_distance;
         best_distance = distance;
-        best = candidate.index;
+        best = candidate;
       } else if (distance < second) {
         second = distance;
       }
