@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "arucoslam/feature/bucket_order.h"
 #include "arucoslam/feature/quadtree_spread.h"
 #include "arucoslam/util/option_check.h"
 
@@ -250,21 +251,14 @@ void DetectWeakCornersInRun(const cv::Mat& image, int threshold, const CellGrid&
   const std::vector<cv::Point> candidates = ScoredCandidates(image, run, threshold, scores);
   // The corners kept, sorted by cell (stable, so row-major inside each).
   std::vector<int> cell_of(candidates.size(), -1);
-  std::vector<int> first_of_cell(cx_end - cx_begin + 1, 0);
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     const int cx = grid.CellX(candidates[i].x);
     const cv::Rect cell = grid.Cells(cx, cx + 1, cy);
-    if (!scores.StrongestAround(candidates[i], cell.x, cell.br().x)) continue;
-    cell_of[i] = cx - cx_begin;
-    ++first_of_cell[cx - cx_begin + 1];
+    if (scores.StrongestAround(candidates[i], cell.x, cell.br().x)) cell_of[i] = cx - cx_begin;
   }
-  for (std::size_t c = 1; c < first_of_cell.size(); ++c) first_of_cell[c] += first_of_cell[c - 1];
-  const std::size_t base = corners.size();
-  corners.resize(base + first_of_cell.back());
-  for (std::size_t i = 0; i < candidates.size(); ++i) {
-    if (cell_of[i] < 0) continue;
-    corners[base + first_of_cell[cell_of[i]]++] =
-        FastKeypoint(candidates[i], scores.At(candidates[i]));
+  const BucketOrder by_cell = SortIntoBuckets(cell_of, cx_end - cx_begin);
+  for (const int i : by_cell.members) {
+    corners.push_back(FastKeypoint(candidates[i], scores.At(candidates[i])));
   }
 }
 

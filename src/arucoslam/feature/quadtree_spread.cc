@@ -5,6 +5,8 @@
 #include <cmath>
 #include <queue>
 
+#include "arucoslam/feature/bucket_order.h"
+
 namespace arucoslam {
 namespace {
 
@@ -65,23 +67,18 @@ std::vector<cv::KeyPoint> SpreadWithQuadtree(const std::vector<cv::KeyPoint>& ke
       std::max(1, static_cast<int>(std::lround(static_cast<double>(region.height) / region.width)));
   const float root_w = static_cast<float>(region.width) / roots_x;
   const float root_h = static_cast<float>(region.height) / roots_y;
-  // The keypoints sorted by root cell (counting sort).
+  // The keypoints sorted by root cell.
   std::vector<int> root_of(keypoints.size());
-  std::vector<int> root_begin(roots_x * roots_y + 1, 0);
   for (std::size_t i = 0; i < keypoints.size(); ++i) {
     const int rx =
         std::clamp(static_cast<int>((keypoints[i].pt.x - region.x) / root_w), 0, roots_x - 1);
     const int ry =
         std::clamp(static_cast<int>((keypoints[i].pt.y - region.y) / root_h), 0, roots_y - 1);
     root_of[i] = ry * roots_x + rx;
-    ++root_begin[root_of[i] + 1];
   }
-  for (std::size_t r = 1; r < root_begin.size(); ++r) root_begin[r] += root_begin[r - 1];
-  std::vector<int> members(keypoints.size());
-  std::vector<int> next = root_begin;
-  for (std::size_t i = 0; i < keypoints.size(); ++i) {
-    members[next[root_of[i]]++] = static_cast<int>(i);
-  }
+  BucketOrder by_root = SortIntoBuckets(root_of, roots_x * roots_y);
+  std::vector<int>& members = by_root.members;  // reordered as cells split
+  const std::vector<int>& root_begin = by_root.begin;
   for (int ry = 0; ry < roots_y; ++ry) {
     for (int rx = 0; rx < roots_x; ++rx) {
       const int root = ry * roots_x + rx;
