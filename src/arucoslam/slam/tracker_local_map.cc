@@ -57,7 +57,6 @@ class PointMarks {
     inserted_.push_back(id.value);
     return true;
   }
-  bool Contains(MapPointId id) const { return id.value < marked_.size() && marked_[id.value] != 0; }
   void Clear() {
     for (const auto value : inserted_) marked_[value] = 0;
     inserted_.clear();
