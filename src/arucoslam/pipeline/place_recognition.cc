@@ -39,11 +39,7 @@ PlaceRecognition::PlaceRecognition(Map& map, std::shared_ptr<const Vocabulary> v
   if (!threaded_) return;
   queue_ = std::make_unique<BoundedQueue<KeyframeId>>(options_.loop_queue_capacity);
   loop_thread_ = std::thread([this] {
-    while (const std::optional<KeyframeId> keyframe = queue_->Pop()) {
-      DetectAndClose(*keyframe);
-      std::lock_guard lock(awaiting_mutex_);
-      awaiting_detection_.erase(*keyframe);
-    }
+    while (const std::optional<KeyframeId> keyframe = queue_->Pop()) DetectAndClose(*keyframe);
   });
   if (options_.loop_closing && options_.global_bundle_adjustment) {
     ba_thread_ = std::thread([this] { GlobalBundleAdjustmentLoop(); });
@@ -97,24 +93,10 @@ void PlaceRecognition::KeyframeMapped(KeyframeId keyframe) {
   if (threaded_) {
     // Never blocks local mapping: when the loop thread is far behind the keyframe is only
     // added to the database.
-    {
-      std::lock_guard lock(awaiting_mutex_);
-      awaiting_detection_.insert(keyframe);
-    }
-    if (queue_->TryPush(keyframe)) return;
-    {
-      std::lock_guard lock(awaiting_mutex_);
-      awaiting_detection_.erase(keyframe);
-    }
-    AddToDatabase(keyframe);
+    if (!queue_->TryPush(keyframe)) AddToDatabase(keyframe);
     return;
   }
   DetectAndClose(keyframe);
-}
-
-bool PlaceRecognition::AwaitsLoopDetection(KeyframeId keyframe) const {
-  std::lock_guard lock(awaiting_mutex_);
-  return awaiting_detection_.count(keyframe) != 0;
 }
 
 void PlaceRecognition::MapMovedExternally() { ++epoch_; }

@@ -9,7 +9,6 @@
 #include <memory>
 #include <mutex>
 #include <optional>
-#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -94,7 +93,6 @@ class PlaceRecognition final : public PlaceIndex {
   void IndexKeyframes(const std::vector<KeyframeId>& keyframes) override;
   // A keyframe finished local mapping: it enters the database and the loop detector.
   void KeyframeMapped(KeyframeId keyframe) override;
-  bool AwaitsLoopDetection(KeyframeId keyframe) const override;
   // Held by local mapping for each keyframe, and by loop closing and world alignment.
   std::unique_lock<std::mutex> LockMapEdits() override { return std::unique_lock(edit_mutex_); }
   // The map was moved from outside (world alignment) while holding LockMapEdits: a running
@@ -160,9 +158,6 @@ class PlaceRecognition final : public PlaceIndex {
   std::map<KeyframeId, double> keyframe_scales_;  // see KeyframeScale
 
   std::unique_ptr<BoundedQueue<KeyframeId>> queue_;
-  // Keyframes queued for the loop thread or in its detection (threaded mode).
-  mutable std::mutex awaiting_mutex_;
-  std::set<KeyframeId> awaiting_detection_;
   std::thread loop_thread_;
   std::mutex ba_mutex_;
   std::condition_variable ba_wake_;

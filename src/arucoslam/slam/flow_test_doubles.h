@@ -48,7 +48,6 @@ class ScriptedPlaces final : public PlaceIndex {
     indexed.insert(indexed.end(), keyframes.begin(), keyframes.end());
   }
   void KeyframeMapped(KeyframeId) override { ++num_mapped; }
-  bool AwaitsLoopDetection(KeyframeId) const override { return all_await_loop_detection; }
   std::unique_lock<std::mutex> LockMapEdits() override { return std::unique_lock(mutex_); }
   void MapMovedExternally() override { ++num_external_moves; }
   void SetMetricMap(bool metric) override { this->metric = metric; }
@@ -63,7 +62,6 @@ class ScriptedPlaces final : public PlaceIndex {
   void Finish() override {}
 
   std::optional<RelocalizationResult> offer;
-  bool all_await_loop_detection = false;  // every keyframe waits for loop detection
   int num_queries = 0;
   int num_taken = 0;
   int num_mapped = 0;

@@ -19,12 +19,10 @@ MarkerWorldParts FrameFlow::MarkerParts() {
 
 void FrameFlow::MakeLocalMapper() {
   mapper_ = std::make_unique<LocalMapper>(*map_, options_.mapper);
-  // Not culled: keyframes anchoring_ keeps, and those waiting for loop detection.
-  mapper_->SetKeyframeGuard([this](const Keyframe& keyframe) {
-    if (options_.marker_map && anchoring_.KeepsKeyframe(keyframe)) return true;
-    const PlaceIndex* places = lifecycle_.places();
-    return places != nullptr && places->AwaitsLoopDetection(keyframe.id);
-  });
+  if (options_.marker_map) {  // keyframes anchoring_ keeps are not culled
+    mapper_->SetKeyframeGuard(
+        [this](const Keyframe& keyframe) { return anchoring_.KeepsKeyframe(keyframe); });
+  }
   if (!options_.inline_mapping && options_.yield_bundle_adjustment) {
     mapper_->SetYieldRequest([this] { return mapping_->KeyframeWaiting(); });
   }

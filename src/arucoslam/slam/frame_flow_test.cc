@@ -162,25 +162,6 @@ TEST(FrameFlow, KeypointsAloneInitialiseTrackAndMapTheSceneUpToScale) {
   EXPECT_LT(RmsError(trajectory, TruthFromEstimate(trajectory)), 0.024);
 }
 
-// Keyframes the loop detector has yet to see are never culled: a loop found for a keyframe
-// that local mapping erased meanwhile would be lost.
-TEST(FrameFlow, KeyframesAwaitingLoopDetectionAreNotCulled) {
-  const auto keyframes_kept = [](bool awaiting) {
-    auto owned = std::make_unique<ScriptedPlaces>();
-    owned->all_await_loop_detection = awaiting;
-    FlowHarness harness(/*markers=*/false, FlowHarness::Options(/*markers=*/false),
-                        std::move(owned));
-    for (int t = 0; t < 80; ++t) harness.Step(t);
-    harness.flow().Finish();
-    return std::make_pair(harness.stats().num_keyframes_inserted,
-                          static_cast<int>(harness.flow().map().NumKeyframes()));
-  };
-  const auto [inserted, kept] = keyframes_kept(false);
-  ASSERT_LT(kept, inserted);  // redundant keyframes are culled otherwise
-  const auto [inserted_awaiting, kept_awaiting] = keyframes_kept(true);
-  EXPECT_EQ(kept_awaiting, inserted_awaiting);
-}
-
 TEST(FrameFlow, KnownMarkersPutTheMapInTheWorldAtMetricScale) {
   FlowHarness harness(/*markers=*/true);
   std::vector<FrameReport> reports;

@@ -30,9 +30,6 @@ class PlaceIndex {
   virtual void IndexKeyframes(const std::vector<KeyframeId>& keyframes) = 0;
   // A keyframe finished local mapping: it enters the database and the loop detector.
   virtual void KeyframeMapped(KeyframeId keyframe) = 0;
-  // Whether `keyframe` waits for, or is in, loop detection on another thread: local mapping
-  // must not cull it meanwhile, or the loop it closes is lost.
-  virtual bool AwaitsLoopDetection(KeyframeId keyframe) const = 0;
   // Held by local mapping for each keyframe, and by loop closing and world alignment.
   virtual std::unique_lock<std::mutex> LockMapEdits() = 0;
   // The map was moved from outside (world alignment) while holding LockMapEdits: a running
