@@ -183,14 +183,14 @@ int LocalMapper::CullRedundantKeyframes(KeyframeId keyframe) {
           HoldsRareMarkerView(*candidate, markers_, options_.min_marker_keyframes)) {
         continue;
       }
-      const int num_points = NumMapPoints(*candidate);
-      const bool lost_its_points = num_points < options_.min_keyframe_points;
+      const bool lost_its_points = HasFewerMapPoints(*candidate, options_.min_keyframe_points);
       if (!lost_its_points && !IsRedundant(data, *candidate, options_.redundant_fraction,
                                            options_.redundant_observers)) {
         continue;
       }
       if (lost_its_points) {
-        ARUCOSLAM_LOG_DEBUG("keyframe {} erased: {} map points left", id.value, num_points);
+        ARUCOSLAM_LOG_DEBUG("keyframe {} erased: {} map points left", id.value,
+                            NumMapPoints(*candidate));
       }
       if (!data.EraseKeyframe(id)) continue;
       ++erased;
