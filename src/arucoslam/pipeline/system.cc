@@ -120,13 +120,13 @@ void System::MapKeyframe(KeyframeId keyframe) {
   const double elapsed = watch.ElapsedMilliseconds();
   ARUCOSLAM_LOG_DEBUG(
       "keyframe {}: {} culled, {} new ({:.0f} ms), {} fused ({:.0f} ms), BA {} kf {} pts "
-      "rms {:.2f}->{:.2f} px{}, {} outliers ({:.0f} ms), {} keyframes culled; {:.0f} ms",
+      "({} fixed kf, {} residuals, {} iterations{}) rms {:.2f}->{:.2f} px, {} outliers "
+      "({:.0f} ms), {} keyframes culled; {:.0f} ms",
       keyframe.value, r.num_culled_points, r.num_new_points, r.triangulation_ms, r.num_fused_points,
       r.fusion_ms, r.bundle_adjustment.num_local_keyframes, r.bundle_adjustment.num_points,
+      r.bundle_adjustment.num_fixed_keyframes, r.bundle_adjustment.summary.num_residual_blocks,
+      r.bundle_adjustment.summary.num_iterations, yielded ? " (yielded)" : "",
       r.bundle_adjustment.summary.initial_rms_px, r.bundle_adjustment.summary.final_rms_px,
-      yielded ? fmt::format(" (yielded after {} iterations)",
-                            r.bundle_adjustment.summary.num_iterations)
-              : std::string(),
       r.bundle_adjustment.num_erased_observations, r.bundle_adjustment_ms, r.num_culled_keyframes,
       elapsed);
   std::lock_guard lock(stats_mutex_);
