@@ -39,6 +39,11 @@ class IndexedMap {
   }
 
   const std::map<Id, T>& map() const { return map_; }
+  // Every element in id order, to be changed in place (ids stay as they are).
+  template <typename Visit>
+  void ForEachMutable(Visit visit) {
+    for (auto& [id, element] : map_) visit(id, element);
+  }
   std::size_t size() const { return map_.size(); }
 
   T* Find(Id id) {

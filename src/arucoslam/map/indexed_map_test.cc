@@ -56,5 +56,19 @@ TEST(IndexedMap, LargeIdsAreFoundWithoutAHugeIndex) {
   EXPECT_EQ(strings.Find(large), nullptr);
 }
 
+TEST(IndexedMap, VisitsEveryElementInIdOrderToChangeItInPlace) {
+  Strings strings;
+  for (const int i : {5, 1, 3}) strings.Emplace(MapPointId(i), std::to_string(i));
+  std::string order;
+  strings.ForEachMutable([&](MapPointId id, std::string& element) {
+    order += element;
+    element += "!";
+    EXPECT_EQ(strings.Find(id), &element);
+  });
+  EXPECT_EQ(order, "135");
+  EXPECT_EQ(*strings.Find(MapPointId(3)), "3!");
+  EXPECT_EQ(strings.map().rbegin()->second, "5!");
+}
+
 }  // namespace
 }  // namespace arucoslam

@@ -191,11 +191,10 @@ void MapData::UpdateDescriptor(MapPointId id) {
 }
 
 void MapData::RecalibrateKeyframes(const CameraModel& camera) {
-  for (const auto& [id, unused] : keyframes_.map()) {
-    Keyframe& keyframe = *keyframes_.Find(id);
+  keyframes_.ForEachMutable([&](KeyframeId, Keyframe& keyframe) {
     keyframe.camera = camera;
     UndistortFeatures(camera, &keyframe.features);
-  }
+  });
 }
 
 void MapData::UpdateNormalAndDepth(MapPointId id) {
