@@ -56,9 +56,8 @@ int LocalMapper::FuseDuplicates(KeyframeId keyframe) {
          data.covisibility().BestCovisible(keyframe, options_.fusion_neighbours)) {
       const Keyframe& target = *data.FindKeyframe(id);
       ProjectAndMatch(data, target, own_points, options_, &actions);
-      for (const MapPointId& point : target.map_point_ids) {
-        if (point.IsValid()) their_points.push_back(point);
-      }
+      const std::vector<MapPointId> points = data.MapPointsOf(id);
+      their_points.insert(their_points.end(), points.begin(), points.end());
     }
     std::sort(their_points.begin(), their_points.end());
     their_points.erase(std::unique(their_points.begin(), their_points.end()), their_points.end());
