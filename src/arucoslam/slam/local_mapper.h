@@ -36,6 +36,11 @@ struct LocalMapperOptions {
   // Scale consistency: distance ratio and pyramid scale ratio may differ by this x the
   // pyramid's scale factor.
   double scale_consistency_factor = 1.5;
+  // A keypoint matched in several neighbours: its point (from the widest-parallax pair) is
+  // kept only when it reprojects within `reprojection_chi2` into every other neighbour's
+  // matched keypoint. Pairs that disagree hold a wrong match, and such points lie too near
+  // more often than too far.
+  bool multi_view_check = true;
   // Fusion: the new keyframe's points are projected into up to this many neighbours (and
   // their points into it) and matched within this radius x scale(level), pixels.
   int fusion_neighbours = 20;

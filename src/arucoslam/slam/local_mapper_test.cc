@@ -49,15 +49,18 @@ struct SceneKeyframe {
 };
 
 // Keyframes at the true poses of `times`; every true point seen by all of them whose index
-// passes `share(j)` becomes a map point at its true position observed by each.
-std::vector<SceneKeyframe> BuildMap(Scene& scene, Map& map, const std::vector<int>& times,
-                                    const std::function<bool(int)>& share) {
+// passes `share(j)` becomes a map point at its true position observed by each. `edit`, when
+// given, may change the k-th keyframe's features first (given their true point indices).
+std::vector<SceneKeyframe> BuildMap(
+    Scene& scene, Map& map, const std::vector<int>& times, const std::function<bool(int)>& share,
+    const std::function<void(std::size_t, const std::vector<int>&, Frame&)>& edit = nullptr) {
   std::vector<SceneKeyframe> keyframes;
   std::vector<std::map<int, int>> index_of;
   std::vector<Frame> frames;
   for (int t : times) {
     SceneKeyframe keyframe;
     frames.push_back(scene.MakeFrame(t, &keyframe.truth));
+    if (edit) edit(frames.size() - 1, keyframe.truth, frames.back());
     std::map<int, int> index;
     for (std::size_t i = 0; i < keyframe.truth.size(); ++i) {
       if (keyframe.truth[i] >= 0) index[keyframe.truth[i]] = static_cast<int>(i);
@@ -197,6 +200,61 @@ TEST(LocalMapper, TriangulatesWithTheWidestParallaxNeighbour) {
   // test); pairing with the first neighbour that passes gave 0% and a median error of 1.26%.
   EXPECT_GE(paired_with_first, 0.7 * seen_in_both);
   EXPECT_LT(relative_errors[relative_errors.size() / 2], 0.01);
+}
+
+// A wrong match in the widest pair: the first keyframe's unmapped keypoints are moved 8 px
+// along their epipolar lines (more parallax, points about 15% too near). The middle
+// keyframe's correct matches disagree with those points, and the check drops them; with
+// correct matches it drops almost none.
+TEST(LocalMapper, MultiViewCheckDropsPointsTheOtherNeighboursContradict) {
+  const auto run = [](bool multi_view_check, float shift_px, int* wrong, int* total) {
+    Scene scene(13);
+    Map map;
+    const auto share = [](int j) { return j % 3 == 0; };
+    const auto shift_first = [&](std::size_t k, const std::vector<int>& truth, Frame& frame) {
+      if (k != 0) return;
+      for (std::size_t i = 0; i < truth.size(); ++i) {
+        if (truth[i] < 0 || share(truth[i])) continue;
+        frame.features.keypoints[i].pt.x += shift_px;
+        frame.features.undistorted[i].x() += shift_px / 500.0;
+      }
+    };
+    const auto keyframes = BuildMap(scene, map, {0, 5, 10}, share, shift_first);
+    LocalMapperOptions options;
+    options.multi_view_check = multi_view_check;
+    LocalMapper mapper(map, options);
+    mapper.TriangulateNewPoints(keyframes[2].id);
+    *wrong = *total = 0;
+    map.Read([&](const MapData& data) {
+      for (const auto& [id, point] : data.map_points()) {
+        const auto current = point.observations.find(keyframes[2].id);
+        if (point.observations.size() != 2 || current == point.observations.end()) continue;
+        const int j = keyframes[2].truth[current->second];
+        if (j < 0) continue;
+        ++*total;
+        const Eigen::Vector3d& truth = scene.points()[j];
+        if ((point.p_in_world - truth).norm() > 0.05 * truth.z()) ++*wrong;
+      }
+      return 0;
+    });
+  };
+  int wrong_unchecked = 0, total_unchecked = 0, wrong_checked = 0, total_checked = 0;
+  run(false, 8.0f, &wrong_unchecked, &total_unchecked);
+  run(true, 8.0f, &wrong_checked, &total_checked);
+  std::printf("shifted, points more than 5%% off: %d of %d unchecked, %d of %d checked\n",
+              wrong_unchecked, total_unchecked, wrong_checked, total_checked);
+  ASSERT_GT(total_unchecked, 100);
+  EXPECT_GT(wrong_unchecked, total_unchecked / 2);
+  // Left: the keypoints that matched in the first keyframe only (23 of them, measured).
+  EXPECT_LT(total_checked, total_unchecked / 10);
+  EXPECT_LE(wrong_checked, total_checked / 10);
+  int clean_unchecked = 0, clean_checked = 0;
+  run(false, 0.0f, &wrong_unchecked, &clean_unchecked);
+  run(true, 0.0f, &wrong_checked, &clean_checked);
+  std::printf("not shifted: %d points unchecked, %d checked (%d off)\n", clean_unchecked,
+              clean_checked, wrong_checked);
+  EXPECT_GE(clean_checked, 0.95 * clean_unchecked);
+  EXPECT_LE(wrong_checked, clean_checked / 100);
 }
 
 TEST(LocalMapper, FusesDuplicatePoints) {

@@ -144,6 +144,17 @@ double MedianDepth(const MapData& data, const Keyframe& keyframe) {
   return depths[depths.size() / 2];
 }
 
+// Whether `p_in_world` reprojects into `keyframe`'s keypoint `index` within the test.
+bool Reprojects(const Keyframe& keyframe, int index, const Eigen::Vector3d& p_in_world,
+                double chi2) {
+  const Eigen::Vector3d p_in_cam = keyframe.cam_from_world * p_in_world;
+  if (!(p_in_cam.z() > 0.0)) return false;
+  const Eigen::Vector2d& observed = keyframe.features.undistorted[index];
+  const double ex = keyframe.camera.fx * (p_in_cam.x() / p_in_cam.z() - observed.x());
+  const double ey = keyframe.camera.fy * (p_in_cam.y() / p_in_cam.z() - observed.y());
+  return ex * ex + ey * ey < chi2 * Sigma2(keyframe, index);
+}
+
 struct NewPoint {
   KeyframeId other;
   int index1 = 0;
@@ -177,20 +188,33 @@ int LocalMapper::TriangulateNewPoints(KeyframeId keyframe) {
   // Taking the first neighbour that passes (the most covisible, usually the nearest) made
   // the parallax test select, among low-parallax matches, those whose noise widened the
   // parallax: their points lay too near, and the map's scale shrank as the camera moved.
-  std::vector<std::optional<NewPoint>> widest(current->features.size());
-  for (const Keyframe& other : neighbours) {
+  // With `multi_view_check`, the other pairs of the keypoint must agree with that point.
+  // pairs[i]: every passing pair of keypoint i, with its neighbour's index in `neighbours`.
+  std::vector<std::vector<std::pair<std::size_t, NewPoint>>> pairs(current->features.size());
+  for (std::size_t n = 0; n < neighbours.size(); ++n) {
+    const Keyframe& other = neighbours[n];
     for (const FeatureMatch& match : MatchAlongEpipolarLines(*current, other, options_)) {
-      const auto point = TriangulateMatch(*current, other, match, options_);
-      std::optional<NewPoint>& best = widest[match.index1];
-      if (point && (!best || point->parallax_cos < best->parallax_cos)) {
-        best = NewPoint{other.id, match.index1, match.index2, point->p_in_world,
-                        point->parallax_cos};
+      if (const auto point = TriangulateMatch(*current, other, match, options_)) {
+        pairs[match.index1].emplace_back(
+            n, NewPoint{other.id, match.index1, match.index2, point->p_in_world,
+                        point->parallax_cos});
       }
     }
   }
   std::vector<NewPoint> candidates;
-  for (const std::optional<NewPoint>& point : widest) {
-    if (point) candidates.push_back(*point);
+  for (const auto& keypoint_pairs : pairs) {
+    if (keypoint_pairs.empty()) continue;
+    const auto widest = std::min_element(
+        keypoint_pairs.begin(), keypoint_pairs.end(),
+        [](const auto& a, const auto& b) { return a.second.parallax_cos < b.second.parallax_cos; });
+    const bool consistent =
+        !options_.multi_view_check ||
+        std::all_of(keypoint_pairs.begin(), keypoint_pairs.end(), [&](const auto& pair) {
+          return &pair == &*widest ||
+                 Reprojects(neighbours[pair.first], pair.second.index2,
+                            widest->second.p_in_world, options_.reprojection_chi2);
+        });
+    if (consistent) candidates.push_back(widest->second);
   }
   return map_.Write([&](MapData& data) {
     int created = 0;

@@ -68,6 +68,8 @@ void VisitOptions(TrackerOptions& o, Visitor& visit) {
         "fewer matches: search again with twice the radius, then fall back");
   visit("recovery_frames", o.recovery_frames,
         "after a loss the motion model keeps predicting for this many frames (0: no retry)");
+  visit("max_prediction_gap_s", o.max_prediction_gap_s,
+        "frames missing for up to this long count as motion-model steps, seconds");
   visit("reference_search", o.reference_search,
         "fallback: brute-force matching against the reference keyframe");
   visit("min_reference_matches", o.min_reference_matches, "matches needed by that fallback");
@@ -131,6 +133,8 @@ void VisitOptions(LocalMapperOptions& o, Visitor& visit) {
         "per-view squared reprojection error below this x sigma^2 (2 dof, 95%)");
   visit("scale_consistency_factor", o.scale_consistency_factor,
         "distance and pyramid scale ratios may differ by this x the scale factor");
+  visit("multi_view_check", o.multi_view_check,
+        "a point matched in several neighbours must reproject into each of them");
   visit("fusion_neighbours", o.fusion_neighbours,
         "fusion: neighbours the points are projected into");
   visit("fusion_radius_px", o.fusion_radius_px, "fusion search radius x scale(level), pixels");

@@ -48,6 +48,7 @@ bool TrackerOptions::Check(std::string* why) const {
   check.Nested("local_map_search", local_map_search);
   check.InRange("min_view_cos", min_view_cos, -1.0, 1.0, Interval::kClosed);
   check.AtLeast("recovery_frames", recovery_frames, 0);
+  check.AtLeast("max_prediction_gap_s", max_prediction_gap_s, 0.0);
   check.AtLeast("min_pose_inliers", min_pose_inliers, 3);
   check.AtLeast("min_local_map_inliers", min_local_map_inliers, min_pose_inliers,
                 "min_pose_inliers");
@@ -72,6 +73,7 @@ void Tracker::Start(const Frame& frame, KeyframeId reference) {
   reference_keyframe_ = reference;
   velocity_.reset();
   frames_lost_ = 0;
+  frame_period_s_ = 0.0;
   state_ = TrackingState::kTracking;
 }
 
@@ -79,6 +81,7 @@ void Tracker::Reset() {
   last_frame_.reset();
   velocity_.reset();
   frames_lost_ = 0;
+  frame_period_s_ = 0.0;
   reference_keyframe_ = KeyframeId();
   state_ = TrackingState::kNotInitialized;
 }
@@ -94,15 +97,27 @@ TrackingResult Tracker::Track(Frame& frame, const std::vector<MarkerPoseObservat
   if (state_ == TrackingState::kNotInitialized || !last_frame_) return result;
   frame.ResetMatches();
   frame.cam_from_world.reset();
-  const int steps = frames_lost_ + 1;
+  // Steps of the motion model: the frames since the last tracked one, or the time elapsed in
+  // frame periods when frames are missing from the stream.
+  int steps = frames_lost_ + 1;
+  bool use_motion = velocity_.has_value();
+  const double elapsed_s = frame.timestamp_s - last_frame_->timestamp_s;
+  if (use_motion && frame_period_s_ > 0.0) {
+    if (elapsed_s > options_.max_prediction_gap_s) {
+      use_motion = false;
+    } else {
+      steps = std::max(steps, static_cast<int>(std::lround(elapsed_s / frame_period_s_)));
+    }
+  }
+  steps_ = steps;
   bool ok = false;
-  if (velocity_) ok = TrackWithMotionModel(frame, result, steps);
+  if (use_motion) ok = TrackWithMotionModel(frame, result, steps);
   if (!ok) {
     frame.ResetMatches();
     ok = TrackReferenceKeyframe(frame, result);
   }
   if (ok) ok = TrackLocalMap(frame, result);
-  if (!ok && velocity_) {
+  if (!ok && use_motion) {
     frame.ResetMatches();
     ok = TrackFromPrediction(frame, result, steps);
   }
@@ -116,7 +131,8 @@ TrackingResult Tracker::Track(Frame& frame, const std::vector<MarkerPoseObservat
     return result;
   }
   velocity_ = *frame.cam_from_world * last_frame_->cam_from_world->Inverse();
-  if (frames_lost_ > 0) velocity_ = Rigid3::Exp(velocity_->Log() / (frames_lost_ + 1));
+  if (steps > 1) velocity_ = Rigid3::Exp(velocity_->Log() / steps);
+  frame_period_s_ = elapsed_s > 0.0 ? elapsed_s / steps : 0.0;
   frames_lost_ = 0;
   last_frame_ = frame;
   state_ = TrackingState::kTracking;
@@ -257,6 +273,7 @@ TrackingResult Tracker::TrackFromPose(Frame& frame, const Rigid3& cam_from_world
   last_frame_ = frame;
   velocity_.reset();
   frames_lost_ = 0;
+  frame_period_s_ = 0.0;
   state_ = TrackingState::kTracking;
   result.state = state_;
   return result;

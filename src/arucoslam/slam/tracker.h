@@ -28,6 +28,11 @@ struct TrackerOptions {
   // frame, search radius doubled) for this many frames, so that a short bland stretch (a
   // turn facing a plain wall) does not end tracking for good. 0: no such retry.
   int recovery_frames = 15;
+  // Frames missing from the stream (dropped, or a gap in the recording) count as steps of the
+  // motion model: it predicts over the time elapsed since the last tracked frame, in units of
+  // the last frame period, for a gap up to this long; after a longer one the reference
+  // keyframe is tried first. Seconds.
+  double max_prediction_gap_s = 3.0;
   // Fallback: brute-force descriptor matching against the reference keyframe.
   BruteForceMatchOptions reference_search{64, 0.75, true, true, {}};
   int min_reference_matches = 15;
@@ -146,6 +151,8 @@ class Tracker {
   std::optional<Frame> last_frame_;
   std::optional<Rigid3> velocity_;
   int frames_lost_ = 0;  // frames since the last tracked one, while lost
+  double frame_period_s_ = 0.0;  // time per motion-model step at the last tracked frame (0: unknown)
+  int steps_ = 1;                // motion-model steps from the last tracked frame to the current one
   KeyframeId reference_keyframe_;
   const std::vector<MarkerPoseObservation>* markers_ = nullptr;  // during Track only
 };

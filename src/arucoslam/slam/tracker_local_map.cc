@@ -142,7 +142,7 @@ bool Tracker::TrackLocalMap(Frame& frame, TrackingResult& result, double radius_
   }
   if (result.num_inliers >= options_.min_local_map_inliers) return true;
   return allow_weak && result.num_inliers >= options_.min_weak_inliers && frame.cam_from_world &&
-         AgreesWithPrediction(*frame.cam_from_world, frames_lost_ + 1);
+         AgreesWithPrediction(*frame.cam_from_world, steps_);
 }
 
 }  // namespace arucoslam

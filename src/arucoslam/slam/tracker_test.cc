@@ -264,6 +264,45 @@ void LoseOneFrameAndRecover(int recovery_frames, const std::string& expected_met
   }
 }
 
+// Frames missing from the stream (timestamps jump by ten periods): the motion model predicts
+// over the elapsed time, tracks the next frame itself, and keeps one period's velocity.
+TEST(TrackerTest, MotionModelPredictsOverMissingFrames) {
+  SyntheticWorld world(4);
+  Map map;
+  Frame start;
+  const KeyframeId reference = BuildInitialMap(world, map, &start);
+  Tracker tracker(map);
+  tracker.Start(start, reference);
+  std::vector<int> truth;
+  for (int t = 6; t <= 10; ++t) {
+    Frame frame = world.MakeFrame(t, &truth);
+    ASSERT_EQ(tracker.Track(frame).state, TrackingState::kTracking);
+  }
+  Frame after_gap = world.MakeFrame(20, &truth);
+  const TrackingResult result = tracker.Track(after_gap);
+  ASSERT_EQ(result.state, TrackingState::kTracking);
+  EXPECT_EQ(result.method, "motion");
+  ASSERT_TRUE(after_gap.cam_from_world.has_value());
+  EXPECT_LT(PositionError(*after_gap.cam_from_world, world.CamFromWorld(20)), 0.005);
+  const Rigid3 expected = world.CamFromWorld(20) * world.CamFromWorld(19).Inverse();
+  ASSERT_TRUE(tracker.velocity().has_value());
+  EXPECT_LT((tracker.velocity()->translation - expected.translation).norm(), 0.005);
+  // A gap longer than max_prediction_gap_s: the reference keyframe, not the stale prediction.
+  TrackerOptions options;
+  options.max_prediction_gap_s = 0.2;
+  Map map2;
+  Frame start2;
+  const KeyframeId reference2 = BuildInitialMap(world, map2, &start2);
+  Tracker short_gaps(map2, options);
+  short_gaps.Start(start2, reference2);
+  for (int t = 6; t <= 10; ++t) {
+    Frame frame = world.MakeFrame(t, &truth);
+    ASSERT_EQ(short_gaps.Track(frame).state, TrackingState::kTracking);
+  }
+  Frame after_gap2 = world.MakeFrame(20, &truth);
+  EXPECT_EQ(short_gaps.Track(after_gap2).method, "reference");
+}
+
 TEST(TrackerTest, LostOnAnUnrelatedFrameThenRecovers) {
   LoseOneFrameAndRecover(15, "motion");
   LoseOneFrameAndRecover(0, "reference");
