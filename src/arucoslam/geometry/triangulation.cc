@@ -37,17 +37,13 @@ double ParallaxAngle(const Eigen::Vector3d& p_in_world, const Eigen::Vector3d& c
   return std::atan2(ray1.cross(ray2).norm(), ray1.dot(ray2));
 }
 
-namespace {
-
-double SquaredErrorPx(const Eigen::Vector3d& p_in_cam, const Eigen::Vector2d& observed, double fx,
-                      double fy) {
+double SquaredReprojectionErrorPx(const Eigen::Vector3d& p_in_cam,
+                                  const Eigen::Vector2d& normalised, double fx, double fy) {
   if (p_in_cam.z() <= 0.0) return std::numeric_limits<double>::infinity();
-  const double ex = fx * (p_in_cam.x() / p_in_cam.z() - observed.x());
-  const double ey = fy * (p_in_cam.y() / p_in_cam.z() - observed.y());
+  const double ex = fx * (p_in_cam.x() / p_in_cam.z() - normalised.x());
+  const double ey = fy * (p_in_cam.y() / p_in_cam.z() - normalised.y());
   return ex * ex + ey * ey;
 }
-
-}  // namespace
 
 TriangulationQuality EvaluateTriangulation(
     const Eigen::Vector3d& p_in_world, const Rigid3& cam1_from_world, const Rigid3& cam2_from_world,
@@ -59,8 +55,8 @@ TriangulationQuality EvaluateTriangulation(
   quality.depth2 = p_in_cam2.z();
   quality.parallax_rad = ParallaxAngle(p_in_world, cam1_from_world.Inverse().translation,
                                        cam2_from_world.Inverse().translation);
-  quality.error1_sq_px = SquaredErrorPx(p_in_cam1, normalised1, fx, fy);
-  quality.error2_sq_px = SquaredErrorPx(p_in_cam2, normalised2, fx, fy);
+  quality.error1_sq_px = SquaredReprojectionErrorPx(p_in_cam1, normalised1, fx, fy);
+  quality.error2_sq_px = SquaredReprojectionErrorPx(p_in_cam2, normalised2, fx, fy);
   return quality;
 }
 

@@ -21,6 +21,11 @@ std::optional<Eigen::Vector3d> TriangulateDlt(const Rigid3& cam1_from_world,
 double ParallaxAngle(const Eigen::Vector3d& p_in_world, const Eigen::Vector3d& centre1_in_world,
                      const Eigen::Vector3d& centre2_in_world);
 
+// Squared reprojection error in pixels of a point in a camera's frame against a normalised
+// observation (normalised error times (fx, fy)); infinity when the point is not in front.
+double SquaredReprojectionErrorPx(const Eigen::Vector3d& p_in_cam,
+                                  const Eigen::Vector2d& normalised, double fx, double fy);
+
 // Geometry of one triangulated point with respect to both views.
 struct TriangulationQuality {
   double depth1 = 0.0;        // z in camera 1 (metres or map units)

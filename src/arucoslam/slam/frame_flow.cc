@@ -58,11 +58,11 @@ void FrameFlow::CountStat(int FrameFlowStats::*counter, int amount) {
   AddToStats(stats_, stats_mutex_, counter, amount);
 }
 
-MapPrediction FrameFlow::Prediction() const {
+MapPrediction FrameFlow::Prediction(double timestamp_s) const {
   MapPrediction prediction;
   prediction.world_aligned = anchoring_.aligned();
   prediction.tracking = tracker_->state() == TrackingState::kTracking;
-  prediction.predicted_cam_from_map = tracker_->PredictedPose();
+  prediction.predicted_cam_from_map = tracker_->PredictedPose(timestamp_s);
   return prediction;
 }
 

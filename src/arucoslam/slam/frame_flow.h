@@ -42,8 +42,8 @@ class FrameFlow {
   // The calibration new frames take: the camera given, its radial distortion refined by
   // radial_calibration on keypoint-only maps (any thread).
   CameraModel Camera() const;
-  // What the map tells marker location about the next frame.
-  MapPrediction Prediction() const;
+  // What the map tells marker location about the frame taken at `timestamp_s`.
+  MapPrediction Prediction(double timestamp_s) const;
   // A frame whose markers were located (marker_fusion()): initialised, tracked or
   // relocalised, a keyframe decided, its pose recorded; `report` gets the outcome.
   void Process(Frame& frame, FrameReport& report);

@@ -216,7 +216,7 @@ TEST(LocalMapper, MultiViewCheckDropsPointsTheOtherNeighboursContradict) {
       for (std::size_t i = 0; i < truth.size(); ++i) {
         if (truth[i] < 0 || share(truth[i])) continue;
         frame.features.keypoints[i].pt.x += shift_px;
-        frame.features.undistorted[i].x() += shift_px / 500.0;
+        frame.features.undistorted[i].x() += shift_px / frame.camera.fx;
       }
     };
     const auto keyframes = BuildMap(scene, map, {0, 5, 10}, share, shift_first);

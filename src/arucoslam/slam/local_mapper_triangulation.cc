@@ -147,12 +147,9 @@ double MedianDepth(const MapData& data, const Keyframe& keyframe) {
 // Whether `p_in_world` reprojects into `keyframe`'s keypoint `index` within the test.
 bool Reprojects(const Keyframe& keyframe, int index, const Eigen::Vector3d& p_in_world,
                 double chi2) {
-  const Eigen::Vector3d p_in_cam = keyframe.cam_from_world * p_in_world;
-  if (!(p_in_cam.z() > 0.0)) return false;
-  const Eigen::Vector2d& observed = keyframe.features.undistorted[index];
-  const double ex = keyframe.camera.fx * (p_in_cam.x() / p_in_cam.z() - observed.x());
-  const double ey = keyframe.camera.fy * (p_in_cam.y() / p_in_cam.z() - observed.y());
-  return ex * ex + ey * ey < chi2 * Sigma2(keyframe, index);
+  return SquaredReprojectionErrorPx(keyframe.cam_from_world * p_in_world,
+                                    keyframe.features.undistorted[index], keyframe.camera.fx,
+                                    keyframe.camera.fy) < chi2 * Sigma2(keyframe, index);
 }
 
 struct NewPoint {

@@ -97,19 +97,9 @@ TrackingResult Tracker::Track(Frame& frame, const std::vector<MarkerPoseObservat
   if (state_ == TrackingState::kNotInitialized || !last_frame_) return result;
   frame.ResetMatches();
   frame.cam_from_world.reset();
-  // Steps of the motion model: the frames since the last tracked one, or the time elapsed in
-  // frame periods when frames are missing from the stream.
-  int steps = frames_lost_ + 1;
-  bool use_motion = velocity_.has_value();
-  const double elapsed_s = frame.timestamp_s - last_frame_->timestamp_s;
-  if (use_motion && frame_period_s_ > 0.0) {
-    if (elapsed_s > options_.max_prediction_gap_s) {
-      use_motion = false;
-    } else {
-      steps = std::max(steps, static_cast<int>(std::lround(elapsed_s / frame_period_s_)));
-    }
-  }
-  steps_ = steps;
+  const std::optional<int> motion_steps = MotionSteps(frame.timestamp_s);
+  const bool use_motion = motion_steps.has_value();
+  const int steps = motion_steps.value_or(frames_lost_ + 1);
   bool ok = false;
   if (use_motion) ok = TrackWithMotionModel(frame, result, steps);
   if (!ok) {
@@ -132,6 +122,7 @@ TrackingResult Tracker::Track(Frame& frame, const std::vector<MarkerPoseObservat
   }
   velocity_ = *frame.cam_from_world * last_frame_->cam_from_world->Inverse();
   if (steps > 1) velocity_ = Rigid3::Exp(velocity_->Log() / steps);
+  const double elapsed_s = frame.timestamp_s - last_frame_->timestamp_s;
   frame_period_s_ = elapsed_s > 0.0 ? elapsed_s / steps : 0.0;
   frames_lost_ = 0;
   last_frame_ = frame;
@@ -139,6 +130,15 @@ TrackingResult Tracker::Track(Frame& frame, const std::vector<MarkerPoseObservat
   result.state = state_;
   LogResult(frame, result);
   return result;
+}
+
+std::optional<int> Tracker::MotionSteps(double timestamp_s) const {
+  if (!velocity_ || !last_frame_) return std::nullopt;
+  const int steps = frames_lost_ + 1;
+  if (!(frame_period_s_ > 0.0)) return steps;
+  const double elapsed_s = timestamp_s - last_frame_->timestamp_s;
+  if (elapsed_s > options_.max_prediction_gap_s) return std::nullopt;
+  return std::max(steps, static_cast<int>(std::lround(elapsed_s / frame_period_s_)));
 }
 
 Rigid3 Tracker::Predict(int steps) const {

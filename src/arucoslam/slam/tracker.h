@@ -116,17 +116,24 @@ class Tracker {
   KeyframeId reference_keyframe() const { return reference_keyframe_; }
   // cam_from_world(current) * world_from_cam(last) after the last successful frame.
   const std::optional<Rigid3>& velocity() const { return velocity_; }
-  // The motion model's prediction of the next frame's pose (cam_from_world, the map's
-  // frame), as Track would use it; nullopt without a last tracked pose and a velocity.
-  std::optional<Rigid3> PredictedPose() const {
+  // The motion model's prediction of the pose of the frame taken at `timestamp_s`
+  // (cam_from_world, the map's frame), as Track would use it; nullopt without a last tracked
+  // pose and a velocity, or after a gap longer than max_prediction_gap_s.
+  std::optional<Rigid3> PredictedPose(double timestamp_s) const {
     if (state_ == TrackingState::kNotInitialized || !last_frame_ ||
-        !last_frame_->cam_from_world || !velocity_) {
+        !last_frame_->cam_from_world) {
       return std::nullopt;
     }
-    return Predict(frames_lost_ + 1);
+    const std::optional<int> steps = MotionSteps(timestamp_s);
+    if (!steps) return std::nullopt;
+    return Predict(*steps);
   }
 
  private:
+  // Steps of the motion model to the frame taken at `timestamp_s`: the frames since the last
+  // tracked one, or more when the time elapsed spans more frame periods (frames missing from
+  // the stream); nullopt without a velocity or after a gap beyond max_prediction_gap_s.
+  std::optional<int> MotionSteps(double timestamp_s) const;
   // `steps`: frames since the last tracked one (1 while tracking).
   bool TrackWithMotionModel(Frame& frame, TrackingResult& result, int steps);
   bool TrackReferenceKeyframe(Frame& frame, TrackingResult& result);
@@ -152,7 +159,6 @@ class Tracker {
   std::optional<Rigid3> velocity_;
   int frames_lost_ = 0;  // frames since the last tracked one, while lost
   double frame_period_s_ = 0.0;  // time per motion-model step at the last tracked frame (0: unknown)
-  int steps_ = 1;                // motion-model steps from the last tracked frame to the current one
   KeyframeId reference_keyframe_;
   const std::vector<MarkerPoseObservation>* markers_ = nullptr;  // during Track only
 };

@@ -141,8 +141,11 @@ bool Tracker::TrackLocalMap(Frame& frame, TrackingResult& result, double radius_
     });
   }
   if (result.num_inliers >= options_.min_local_map_inliers) return true;
-  return allow_weak && result.num_inliers >= options_.min_weak_inliers && frame.cam_from_world &&
-         AgreesWithPrediction(*frame.cam_from_world, steps_);
+  if (!allow_weak || result.num_inliers < options_.min_weak_inliers || !frame.cam_from_world) {
+    return false;
+  }
+  const std::optional<int> steps = MotionSteps(frame.timestamp_s);
+  return steps && AgreesWithPrediction(*frame.cam_from_world, *steps);
 }
 
 }  // namespace arucoslam
