@@ -154,6 +154,23 @@ TEST_F(RealInputsTest, RunUsesTheRational8CalibrationFile) {
   EXPECT_LT(rms_m, 0.01);
 }
 
+// RMS distance of `estimate`'s camera positions from the data set's per-frame PnP poses (frame
+// i of the reference has timestamp 1e9 + i s); a frame outside the reference counts as 1 m off.
+double PositionRmsFromPnpReference(const Trajectory& estimate, const Trajectory& reference) {
+  if (estimate.size() == 0) return 1.0;
+  double sum = 0.0;
+  for (std::size_t i = 0; i < estimate.size(); ++i) {
+    const long long r = std::llround(estimate.timestamps[i] - 1e9);
+    if (r < 0 || static_cast<std::size_t>(r) >= reference.size()) {
+      sum += 1.0;
+      continue;
+    }
+    sum += (estimate.poses[i].translation - reference.poses[static_cast<std::size_t>(r)].translation)
+               .squaredNorm();
+  }
+  return std::sqrt(sum / estimate.size());
+}
+
 // Marker-first mapping on the real board: `run` maps the board's markers from frames posed by
 // markers alone (no keypoint map settles here: a hand-held planar scene), poses every frame,
 // and the mapped corners match the printed layout.
@@ -203,13 +220,7 @@ TEST_F(RealInputsTest, MapsTheBoardFromOneKnownMarker) {
   const BoardMapping mapping = MapBoard("--markers " + (dir_ / "one.json").string(), dir_ / "out");
   const Trajectory& estimate = mapping.trajectory;
   const Trajectory reference = ReadTumTrajectory(kLifecam / "reference_pnp_world_from_cam_tum.txt");
-  double pose_sum = 0.0;
-  for (std::size_t i = 0; i < estimate.size(); ++i) {
-    const std::size_t r = static_cast<std::size_t>(std::llround(estimate.timestamps[i] - 1e9));
-    ASSERT_LT(r, reference.size());
-    pose_sum += (estimate.poses[i].translation - reference.poses[r].translation).squaredNorm();
-  }
-  const double pose_rms_m = std::sqrt(pose_sum / std::max<std::size_t>(1, estimate.size()));
+  const double pose_rms_m = PositionRmsFromPnpReference(estimate, reference);
   std::printf("lifecam, marker 13 known: %zu of %zu frames posed, %zu markers, corners %.2f mm "
               "RMS from the layout (rigid), poses %.2f mm RMS from the PnP reference\n",
               estimate.size(), reference.size(), mapping.mapped.markers.size(),
@@ -218,6 +229,21 @@ TEST_F(RealInputsTest, MapsTheBoardFromOneKnownMarker) {
   EXPECT_GE(estimate.size(), static_cast<std::size_t>(std::ceil(0.99 * reference.size())));
   EXPECT_LT(mapping.corner_rms_m, 0.002);
   EXPECT_LT(pose_rms_m, 0.005);
+}
+
+// With the whole board known, every frame is located from the markers it sees and its pose
+// agrees with the data set's per-frame PnP on the ChArUco corners.
+TEST_F(RealInputsTest, PosesWithTheWholeBoardKnownAgreeWithPerFramePnp) {
+  if (!fs::exists(kLifecam)) GTEST_SKIP() << "test data missing: " << kLifecam;
+  WriteMarkerMapJson(BoardMarkers(), dir_ / "board.json");
+  const BoardMapping mapping = MapBoard("--markers " + (dir_ / "board.json").string(), dir_ / "out");
+  const Trajectory reference = ReadTumTrajectory(kLifecam / "reference_pnp_world_from_cam_tum.txt");
+  const double pose_rms_m = PositionRmsFromPnpReference(mapping.trajectory, reference);
+  std::printf("lifecam, whole board known: %zu of %zu frames posed, poses %.2f mm RMS from the "
+              "PnP reference\n",
+              mapping.trajectory.size(), reference.size(), 1e3 * pose_rms_m);
+  EXPECT_EQ(mapping.trajectory.size(), reference.size());
+  EXPECT_LT(pose_rms_m, 0.002);
 }
 
 // With no marker known, the first frame's largest marker becomes the world's origin and the
