@@ -19,8 +19,6 @@ bool LocalMapperOptions::Check(std::string* why) const {
   check.Above("epipolar_chi2", epipolar_chi2, 0.0);
   check.AtLeast("min_epipole_distance_px", min_epipole_distance_px, 0.0);
   check.InRange("max_parallax_cos", max_parallax_cos, 0.0, 1.0, Interval::kOpen);
-  check.InRange("max_measured_parallax_cos", max_measured_parallax_cos, 0.0, 1.0,
-                Interval::kOpen);
   check.Above("reprojection_chi2", reprojection_chi2, 0.0);
   check.AtLeast("scale_consistency_factor", scale_consistency_factor, 1.0);
   check.AtLeast("fusion_neighbours", fusion_neighbours, 0);

@@ -24,22 +24,13 @@ struct LocalMapperOptions {
   double epipolar_chi2 = 3.841;
   // Candidates closer than this x scale(level) pixels to the epipole are skipped.
   double min_epipole_distance_px = 10.0;
-  // The parallax floor: the pair's rays must make an angle with cosine below this (0.99999:
-  // about 0.26 degrees). Bundle adjustment refines low-parallax points as more keyframes see
-  // them.
+  // Rays must make an angle with cosine below this (0.99999: about 0.26 degrees). A test on
+  // the measured parallax keeps, among matches near the threshold, those whose noise widened
+  // the angle, so their points lie too near and the map shrinks; the widest-parallax pairing
+  // (TriangulateNewPoints) and a low floor shrink it least on the simulated routes
+  // (BENCHMARKS.md, "Keypoint-only scale drift"). Bundle adjustment refines the
+  // low-parallax points as more keyframes see them.
   double max_parallax_cos = 0.99999;
-  // What the floor tests, and which pair triangulates a keypoint matched in several
-  // neighbours. A test on the measured rays keeps, among matches near the floor, those whose
-  // noise widened the angle, and the widest measured pair is chosen the same way: such
-  // points lie too near, and the map shrinks as the camera moves forward. With
-  // `expected_parallax` the floor tests the angle the pair's baseline makes across the
-  // keyframe's ray at the keyframe's median depth, and the pair is the neighbour with the
-  // widest such baseline; neither depends on the match's own noise. The measured rays then
-  // need only an angle with cosine below `max_measured_parallax_cos` (0.999999: about 0.08
-  // degrees, a pixel at 700 px focal length): closer rays carry no depth. False: the floor
-  // and the choice on the measured rays.
-  bool expected_parallax = true;
-  double max_measured_parallax_cos = 0.999999;
   // Reprojection test per view: squared error below chi2(2 dof, 95%) x sigma^2.
   double reprojection_chi2 = 5.991;
   // Scale consistency: distance ratio and pyramid scale ratio may differ by this x the

@@ -95,16 +95,12 @@ std::vector<FeatureMatch> MatchAlongEpipolarLines(const Keyframe& kf1, const Key
 
 struct TriangulatedMatch {
   Eigen::Vector3d p_in_world;
-  // How wide the pair sees the point, larger is wider: the extent of the baseline across
-  // kf1's ray (expected_parallax), else minus the cosine of the measured rays' angle.
-  double width = 0.0;
+  double parallax_cos = 1.0;  // cosine of the angle between the two viewing rays
 };
 
-// The point of a match when it passes every check, else nullopt. `kf1_median_depth`: kf1's
-// median scene depth.
+// The point of a match when it passes every check, else nullopt.
 std::optional<TriangulatedMatch> TriangulateMatch(const Keyframe& kf1, const Keyframe& kf2,
                                                 const FeatureMatch& match,
-                                                double kf1_median_depth,
                                                 const LocalMapperOptions& options) {
   const Eigen::Vector2d& x1 = kf1.features.undistorted[match.index1];
   const Eigen::Vector2d& x2 = kf2.features.undistorted[match.index2];
@@ -113,17 +109,7 @@ std::optional<TriangulatedMatch> TriangulateMatch(const Keyframe& kf1, const Key
   const Eigen::Vector3d ray2 =
       kf2.cam_from_world.rotation.conjugate() * x2.homogeneous().normalized();
   const double parallax_cos = ray1.dot(ray2);
-  double width = -parallax_cos;
-  // Without a median depth (a keyframe without points) the floor falls back to the rays.
-  if (options.expected_parallax && kf1_median_depth > 0.0) {
-    width = (kf2.CameraCenter() - kf1.CameraCenter()).cross(ray1).norm();
-    const double floor_sin =
-        std::sqrt(1.0 - options.max_parallax_cos * options.max_parallax_cos);
-    if (width < floor_sin * kf1_median_depth) return std::nullopt;
-    if (parallax_cos >= options.max_measured_parallax_cos) return std::nullopt;
-  } else if (parallax_cos >= options.max_parallax_cos) {
-    return std::nullopt;
-  }
+  if (parallax_cos >= options.max_parallax_cos) return std::nullopt;
   const std::optional<Eigen::Vector3d> point =
       TriangulateDlt(kf1.cam_from_world, kf2.cam_from_world, x1, x2);
   if (!point) return std::nullopt;
@@ -143,7 +129,7 @@ std::optional<TriangulatedMatch> TriangulateMatch(const Keyframe& kf1, const Key
   if (distance_ratio * factor < octave_ratio || distance_ratio > octave_ratio * factor) {
     return std::nullopt;
   }
-  return TriangulatedMatch{*point, width};
+  return TriangulatedMatch{*point, parallax_cos};
 }
 
 double MedianDepth(const MapData& data, const Keyframe& keyframe) {
@@ -171,7 +157,7 @@ struct NewPoint {
   int index1 = 0;
   int index2 = 0;
   Eigen::Vector3d p_in_world;
-  double width = 0.0;  // TriangulatedMatch::width
+  double parallax_cos = 1.0;
 };
 
 }  // namespace
@@ -180,12 +166,10 @@ int LocalMapper::TriangulateNewPoints(KeyframeId keyframe) {
   // Copies of the keyframes, so that matching runs without holding the map's lock.
   std::optional<Keyframe> current;
   std::vector<Keyframe> neighbours;
-  double current_median_depth = 0.0;
   map_.Read([&](const MapData& data) {
     const Keyframe* found = data.FindKeyframe(keyframe);
     if (found == nullptr) return;
     current = *found;
-    current_median_depth = MedianDepth(data, *found);
     for (const KeyframeId& id :
          data.covisibility().BestCovisible(keyframe, options_.triangulation_neighbours)) {
       const Keyframe& other = *data.FindKeyframe(id);
@@ -197,30 +181,29 @@ int LocalMapper::TriangulateNewPoints(KeyframeId keyframe) {
     }
   });
   if (!current) return 0;
-  // Each keypoint is triangulated with the neighbour that sees it widest (expected_parallax
-  // says how that is judged). Taking the first neighbour that passes (the most covisible,
-  // usually the nearest) made the parallax test select, among low-parallax matches, those
-  // whose noise widened the parallax: their points lay too near, and the map's scale shrank
-  // as the camera moved. With `multi_view_check`, the other pairs of the keypoint must agree
-  // with that point.
+  // Each keypoint is triangulated with the neighbour that sees it under the widest parallax.
+  // Taking the first neighbour that passes (the most covisible, usually the nearest) made
+  // the parallax test select, among low-parallax matches, those whose noise widened the
+  // parallax: their points lay too near, and the map's scale shrank as the camera moved.
+  // With `multi_view_check`, the other pairs of the keypoint must agree with that point.
   // pairs[i]: every passing pair of keypoint i, with its neighbour's index in `neighbours`.
   std::vector<std::vector<std::pair<std::size_t, NewPoint>>> pairs(current->features.size());
   for (std::size_t n = 0; n < neighbours.size(); ++n) {
     const Keyframe& other = neighbours[n];
     for (const FeatureMatch& match : MatchAlongEpipolarLines(*current, other, options_)) {
-      if (const auto point =
-              TriangulateMatch(*current, other, match, current_median_depth, options_)) {
+      if (const auto point = TriangulateMatch(*current, other, match, options_)) {
         pairs[match.index1].emplace_back(
-            n, NewPoint{other.id, match.index1, match.index2, point->p_in_world, point->width});
+            n, NewPoint{other.id, match.index1, match.index2, point->p_in_world,
+                        point->parallax_cos});
       }
     }
   }
   std::vector<NewPoint> candidates;
   for (const auto& keypoint_pairs : pairs) {
     if (keypoint_pairs.empty()) continue;
-    const auto widest = std::max_element(
+    const auto widest = std::min_element(
         keypoint_pairs.begin(), keypoint_pairs.end(),
-        [](const auto& a, const auto& b) { return a.second.width < b.second.width; });
+        [](const auto& a, const auto& b) { return a.second.parallax_cos < b.second.parallax_cos; });
     const bool consistent =
         !options_.multi_view_check ||
         std::all_of(keypoint_pairs.begin(), keypoint_pairs.end(), [&](const auto& pair) {

@@ -128,12 +128,7 @@ void VisitOptions(LocalMapperOptions& o, Visitor& visit) {
         "squared epipolar distance below this x sigma^2 (1 dof, 95%)");
   visit("min_epipole_distance_px", o.min_epipole_distance_px,
         "candidates nearer the epipole than this x scale(level) are skipped, pixels");
-  visit("max_parallax_cos", o.max_parallax_cos,
-        "parallax floor: the pair's rays must make an angle with cosine below this");
-  visit("expected_parallax", o.expected_parallax,
-        "the floor and the pair choice on the angle the baseline makes across the ray at the median depth (false: on the measured rays)");
-  visit("max_measured_parallax_cos", o.max_measured_parallax_cos,
-        "with expected_parallax: the measured rays' angle must have a cosine below this");
+  visit("max_parallax_cos", o.max_parallax_cos, "rays must make an angle with cosine below this");
   visit("reprojection_chi2", o.reprojection_chi2,
         "per-view squared reprojection error below this x sigma^2 (2 dof, 95%)");
   visit("scale_consistency_factor", o.scale_consistency_factor,
