@@ -200,8 +200,9 @@ void System::LocateWithMarkers(Frame& frame, const std::vector<MarkerDetection>&
   if (!marker_frontend_) return;
   OnlineMarkerMapping& marker_mapping = flow_.marker_mapping();
   marker_mapping.AdoptWorldOrigin(detections, frame.camera);
-  marker_frontend_->Locate(detections, *marker_mapping.LocatingMarkers(), flow_.Prediction(frame.timestamp_s),
-                           report.index, &frame, &flow_.marker_fusion());
+  marker_frontend_->Locate(detections, *marker_mapping.LocatingMarkers(),
+                           flow_.Prediction(frame.timestamp_s), report.index, &frame,
+                           &flow_.marker_fusion());
   report.num_markers = flow_.marker_fusion().num_markers();
 }
 

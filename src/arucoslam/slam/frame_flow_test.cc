@@ -75,7 +75,8 @@ class FlowHarness {
       }
       flow_.marker_mapping().AdoptWorldOrigin(detections, frame.camera);
       flow_.marker_fusion().Locate(detections, *flow_.marker_mapping().LocatingMarkers(),
-                                   frame.timestamp_s, flow_.Prediction(frame.timestamp_s), report.index);
+                                   frame.timestamp_s, flow_.Prediction(frame.timestamp_s),
+                                   report.index);
     }
     flow_.Process(frame, report);
     for (const KeyframeId keyframe : mapping_.pending) flow_.MapKeyframe(keyframe);

@@ -158,7 +158,8 @@ class Tracker {
   std::optional<Frame> last_frame_;
   std::optional<Rigid3> velocity_;
   int frames_lost_ = 0;  // frames since the last tracked one, while lost
-  double frame_period_s_ = 0.0;  // time per motion-model step at the last tracked frame (0: unknown)
+  // Time per motion-model step at the last tracked frame (0: unknown).
+  double frame_period_s_ = 0.0;
   KeyframeId reference_keyframe_;
   const std::vector<MarkerPoseObservation>* markers_ = nullptr;  // during Track only
 };
