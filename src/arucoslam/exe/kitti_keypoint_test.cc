@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "arucoslam/eval/evaluation.h"
 #include "arucoslam/exe/command_test_util.h"
 #include "arucoslam/io/trajectory_io.h"
@@ -52,6 +54,19 @@ TEST(KittiKeypointSlam, First160FramesOfSequence07) {
   EXPECT_LE(ate, 0.25);
   const std::string stats = ReadTextFile(out / "stats.json");
   EXPECT_NE(stats.find("\"radial_calibrations\": 1"), std::string::npos) << stats;
+  // Local mapping's steps are timed per keyframe: each is counted once per mapped keyframe,
+  // and together they take no longer than the whole.
+  const nlohmann::json timings = nlohmann::json::parse(stats)["timings_ms"];
+  const nlohmann::json& whole = timings["local_mapping"];
+  ASSERT_GT(whole["count"].get<int>(), 10);
+  double steps_mean = 0.0;
+  for (const char* step : {"triangulation", "fusion", "local_bundle_adjustment", "culling"}) {
+    ASSERT_TRUE(timings.contains(step)) << step;
+    EXPECT_EQ(timings[step]["count"].get<int>(), whole["count"].get<int>()) << step;
+    EXPECT_GT(timings[step]["mean"].get<double>(), 0.0) << step;
+    steps_mean += timings[step]["mean"].get<double>();
+  }
+  EXPECT_LE(steps_mean, whole["mean"].get<double>());
   fs::remove_all(out);
 }
 

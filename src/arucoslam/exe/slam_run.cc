@@ -70,7 +70,11 @@ SlamRunStats MakeStats(const std::string& dataset_label, const FrameSource& sour
   out.timings_ms = {{"extraction", stats.extraction_ms.Summarize()},
                     {"tracking", stats.tracking_ms.Summarize()},
                     {"frame", stats.frame_ms.Summarize()},
-                    {"local_mapping", stats.local_mapping_ms.Summarize()}};
+                    {"local_mapping", stats.local_mapping_ms.Summarize()},
+                    {"triangulation", stats.triangulation_ms.Summarize()},
+                    {"fusion", stats.fusion_ms.Summarize()},
+                    {"local_bundle_adjustment", stats.local_bundle_adjustment_ms.Summarize()},
+                    {"culling", stats.culling_ms.Summarize()}};
   if (stats.places.loop_detection_ms.Count() > 0 || stats.places.num_relocalization_attempts > 0) {
     out.timings_ms.push_back({"relocalisation", stats.places.relocalization_ms.Summarize()});
     out.timings_ms.push_back({"loop_detection", stats.places.loop_detection_ms.Summarize()});

@@ -131,6 +131,10 @@ void System::MapKeyframe(KeyframeId keyframe) {
       elapsed);
   std::lock_guard lock(stats_mutex_);
   stats_.local_mapping_ms.Add(elapsed);
+  stats_.triangulation_ms.Add(r.triangulation_ms);
+  stats_.fusion_ms.Add(r.fusion_ms);
+  stats_.local_bundle_adjustment_ms.Add(r.bundle_adjustment_ms);
+  stats_.culling_ms.Add(r.culling_ms);
   if (yielded) ++stats_.num_yielded_bundle_adjustments;
 }
 

@@ -24,6 +24,12 @@ struct SystemStats : FrameFlowStats {
                                  // (no extraction, no local mapping)
   TimingStats frame_ms;          // per frame, everything on the tracking thread
   TimingStats local_mapping_ms;  // per keyframe
+  // Its steps, per keyframe: new points, duplicate fusion, local BA (with building the
+  // problem and writing it back), point and keyframe culling.
+  TimingStats triangulation_ms;
+  TimingStats fusion_ms;
+  TimingStats local_bundle_adjustment_ms;
+  TimingStats culling_ms;
   int num_frames = 0;
   int num_lost = 0;              // frames in state lost
   TimingStats marker_ms;          // per frame with a marker map: detection and location
