@@ -17,6 +17,7 @@ bool CameraLocatorOptions::Check(std::string* why) const {
   check.InRange("ransac_confidence", ransac_confidence, 0.0, 1.0, Interval::kOpen);
   check.AtLeast("min_inlier_corners", min_inlier_corners, 4);
   check.AtLeast("refine_max_iterations", refine_max_iterations, 0);
+  check.InRange("max_view_angle_deg", max_view_angle_deg, 0.0, 90.0, Interval::kOpenClosed);
   check.Nested("marker_pose", marker_pose);
   return check.ok();
 }
@@ -28,6 +29,10 @@ struct Correspondences {
   std::vector<cv::Point2d> normalised;
   std::vector<Eigen::Vector2d> pixels;
   std::vector<int> marker_ids;  // per corner
+  // Per corner: its marker's centre and printed side's normal, in the world.
+  std::vector<Eigen::Vector3d> marker_centres;
+  std::vector<Eigen::Vector3d> marker_normals;
+  double min_view_cosine = 0.0;  // cos(max_view_angle_deg)
 };
 
 struct Score {
@@ -38,12 +43,16 @@ struct Score {
   }
 };
 
-// Pixel error of each correspondence under world_from_cam (infinite behind the camera).
+// Pixel error of each correspondence under world_from_cam: infinite behind the camera, and
+// for the corners of a marker the camera would see from behind or more edge-on than
+// max_view_angle_deg (it cannot have been detected there).
 std::vector<double> PixelErrors(const Correspondences& c, const CameraModel& camera,
                                 const Rigid3& world_from_cam) {
   const Rigid3 cam_from_world = world_from_cam.Inverse();
   std::vector<double> errors(c.pixels.size(), std::numeric_limits<double>::infinity());
   for (size_t i = 0; i < c.pixels.size(); ++i) {
+    const Eigen::Vector3d to_camera = world_from_cam.translation - c.marker_centres[i];
+    if (!(c.marker_normals[i].dot(to_camera) > c.min_view_cosine * to_camera.norm())) continue;
     const Eigen::Vector3d p(c.in_world[i].x, c.in_world[i].y, c.in_world[i].z);
     const auto projected = camera.Project(cam_from_world * p);
     if (projected) errors[i] = (*projected - c.pixels[i]).norm();
@@ -96,7 +105,10 @@ void CollectKnownCorners(const std::vector<MarkerDetection>& detections, const M
       continue;
     }
     const std::array<Eigen::Vector3d, 4> in_world = info->CornersInWorld();
+    const Eigen::Vector3d normal = info->world_from_marker.rotation * Eigen::Vector3d::UnitZ();
     for (int k = 0; k < 4; ++k) {
+      c.marker_centres.push_back(info->world_from_marker.translation);
+      c.marker_normals.push_back(normal);
       const Eigen::Vector2d xy = camera.Unproject(detection.corners[k]);
       c.in_world.emplace_back(in_world[k].x(), in_world[k].y(), in_world[k].z());
       c.normalised.emplace_back(xy.x(), xy.y());
@@ -169,15 +181,13 @@ void FillSingleMarkerAmbiguity(const std::vector<MarkerPose>& marker_poses, cons
     const Rigid3 b = info->world_from_marker * pose.solutions[1].cam_from_marker.Inverse();
     const Rigid3 alternative = distance(a) > distance(b) ? a : b;
     const double threshold = options.inlier_threshold_px;
-    const Rigid3 refined =
-        Refine(c, camera, alternative, threshold, options.refine_max_iterations);
+    const Rigid3 refined = Refine(c, camera, alternative, threshold, options.refine_max_iterations);
     const Score before = ScorePose(c, camera, alternative, threshold);
     const Score after = ScorePose(c, camera, refined, threshold);
     const bool keeps_basin = distance(refined) > 0.5 * distance(alternative);
     result.alternative_world_from_cam =
-        keeps_basin && after.inliers >= before.inliers && after.cost <= before.cost
-            ? refined
-            : alternative;
+        keeps_basin && after.inliers >= before.inliers && after.cost <= before.cost ? refined
+                                                                                    : alternative;
     const std::vector<double> errors = PixelErrors(c, camera, *result.alternative_world_from_cam);
     double sum = 0.0;
     int count = 0;
@@ -193,8 +203,7 @@ void FillSingleMarkerAmbiguity(const std::vector<MarkerPose>& marker_poses, cons
 // Rotation of `pose` from a predicted orientation in units of the rotation gate.
 double RotationGateUnits(const Rigid3& pose, const Eigen::Quaterniond& predicted,
                          const AmbiguityPriorGates& gates) {
-  return RotationAngle(pose.rotation.inverse() * predicted) * 180.0 / M_PI /
-         gates.max_rotation_deg;
+  return RotationAngle(pose.rotation.inverse() * predicted) * 180.0 / M_PI / gates.max_rotation_deg;
 }
 
 // Distance of `pose` from `predicted` in units of its gate (the larger of rotation and
@@ -230,6 +239,7 @@ CameraLocation LocateCamera(const std::vector<MarkerDetection>& detections, cons
     return result;
   }
   Correspondences c;
+  c.min_view_cosine = std::cos(options.max_view_angle_deg * M_PI / 180.0);
   std::vector<Rigid3> hypotheses;
   std::vector<MarkerPose> marker_poses;
   std::set<int> unknown;

@@ -21,6 +21,10 @@ struct CameraLocatorOptions {
   double ransac_confidence = 0.999;  // in (0, 1)
   int min_inlier_corners = 4;        // fewer inliers: no pose
   int refine_max_iterations = 30;    // Levenberg-Marquardt iterations (0: no refinement)
+  // A pose that would show a detected marker from behind, or more edge-on than this angle
+  // between its printed side's normal and the line of sight, explains none of its corners:
+  // no detector reads a marker there, but a misread sliver fits such a degenerate pose.
+  double max_view_angle_deg = 85.0;  // (0, 90]
   MarkerPoseOptions marker_pose;     // per-marker IPPE and its ambiguity test
 
   bool Check(std::string* why = nullptr) const;
@@ -34,7 +38,7 @@ struct LocateQuality {
   // True when the pose rests on one marker whose IPPE solutions are ambiguous: the
   // alternative pose below then explains the image almost as well.
   bool ambiguous = false;
-  double error_ratio = 0.0;  // one marker: IPPE best / second error; several: 0
+  double error_ratio = 0.0;         // one marker: IPPE best / second error; several: 0
   double alternative_rms_px = 0.0;  // one marker: corner RMS of the alternative, pixels
 };
 

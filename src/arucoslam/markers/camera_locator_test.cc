@@ -212,13 +212,46 @@ TEST(CameraLocatorTest, WrongMarkerInMapIsRejectedByRansac) {
     map.markers[i] = info;
   }
   const cv::Mat image = RenderSyntheticView(SyntheticCamera640(), markers, {});
-  const CameraLocation location = LocateCamera(MarkerDetector().Detect(image), map, SyntheticCamera640());
+  const CameraLocation location =
+      LocateCamera(MarkerDetector().Detect(image), map, SyntheticCamera640());
   ASSERT_TRUE(location.found);
   EXPECT_EQ(location.marker_ids, (std::vector<int>{0, 1, 3}));
   EXPECT_EQ(location.quality.num_corners, 16);
   EXPECT_EQ(location.quality.num_inlier_corners, 12);
   EXPECT_LT((location.world_from_cam.translation - world_from_cam.translation).norm(), 0.02);
   EXPECT_LT(location.quality.reprojection_rms_px, 0.5);
+}
+
+TEST(CameraLocatorTest, APoseSeeingAMarkerFromBehindExplainsNoneOfIt) {
+  // A marker 2 m ahead, 20 degrees off its normal; its corners in mirrored order are what the
+  // camera would see from behind it, which no detector reads (a misread sliver is like it).
+  MarkerMap map;
+  MarkerInfo info;
+  info.id = 3;
+  info.size = 0.2;
+  info.world_from_marker =
+      Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ())),
+             Eigen::Vector3d(1.0, 2.0, 1.0));
+  map.markers[info.id] = info;
+  const Eigen::Matrix3d facing = Eigen::Vector3d(1, -1, -1).asDiagonal();
+  const Rigid3 cam_from_marker(
+      Eigen::Quaterniond(Eigen::AngleAxisd(20.0 * M_PI / 180.0, Eigen::Vector3d::UnitX()) * facing),
+      Eigen::Vector3d(0.1, -0.05, 2.0));
+  MarkerDetection seen;
+  seen.id = info.id;
+  const std::array<Eigen::Vector3d, 4> corners = SquareCorners(info.size);
+  for (int c = 0; c < 4; ++c) {
+    seen.corners[c] = *SyntheticCamera640().Project(cam_from_marker * corners[c]);
+  }
+  const CameraLocation front = LocateCamera({seen}, map, SyntheticCamera640());
+  ASSERT_TRUE(front.found) << front.failure;
+  const Rigid3 world_from_cam = info.world_from_marker * cam_from_marker.Inverse();
+  EXPECT_LT((front.world_from_cam.translation - world_from_cam.translation).norm(), 0.01);
+
+  MarkerDetection mirrored = seen;
+  std::swap(mirrored.corners[1], mirrored.corners[3]);
+  const CameraLocation behind = LocateCamera({mirrored}, map, SyntheticCamera640());
+  EXPECT_FALSE(behind.found);
 }
 
 TEST(CameraLocatorTest, NoKnownMarkerIsAValue) {
@@ -240,8 +273,8 @@ struct AmbiguousView {
 
 // One 0.1 m marker `depth` metres away seen `tilt_deg` off its normal (towards `azimuth`),
 // corners projected with Gaussian noise of `noise_px`.
-AmbiguousView MakeSingleMarkerView(double depth, double tilt_deg, double azimuth,
-                                   double noise_px, std::mt19937& rng) {
+AmbiguousView MakeSingleMarkerView(double depth, double tilt_deg, double azimuth, double noise_px,
+                                   std::mt19937& rng) {
   const double size = 0.1;
   const Eigen::Matrix3d facing = Eigen::Vector3d(1, -1, -1).asDiagonal();
   const Eigen::Vector3d axis(std::cos(azimuth), std::sin(azimuth), 0.0);
@@ -252,8 +285,9 @@ AmbiguousView MakeSingleMarkerView(double depth, double tilt_deg, double azimuth
   MarkerInfo info;
   info.id = 3;
   info.size = size;
-  info.world_from_marker = Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ())),
-                                  Eigen::Vector3d(1.0, 2.0, 1.0));
+  info.world_from_marker =
+      Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ())),
+             Eigen::Vector3d(1.0, 2.0, 1.0));
   map.markers[info.id] = info;
   std::normal_distribution<double> noise(0.0, noise_px);
   MarkerDetection detection;
@@ -317,7 +351,8 @@ TEST(CameraLocatorTest, PredictedOrientationAloneSettlesAnAmbiguousMarker) {
     const AmbiguousView view = MakeSingleMarkerView(0.8, 12.0, 2.0 * M_PI * k / 12, 0.05, rng);
     if (!view.location.found || !view.location.quality.ambiguous) continue;
     const CameraLocation& location = view.location;
-    const AmbiguityChoice choice = ResolveAmbiguityByRotation(location, view.world_from_cam.rotation);
+    const AmbiguityChoice choice =
+        ResolveAmbiguityByRotation(location, view.world_from_cam.rotation);
     ASSERT_NE(choice, AmbiguityChoice::kNone) << "view " << k;
     ++settled;
     EXPECT_LT(DegreesBetween(*ChosenPose(location, choice), view.world_from_cam), 1.0);
@@ -349,13 +384,14 @@ TEST(CameraLocatorTest, MotionPriorPicksTheSolutionNearerTheTruth) {
     ++settled;
     alternatives += choice == AmbiguityChoice::kAlternative;
     const Rigid3 chosen = *ChosenPose(view.location, choice);
-    const Rigid3 other = choice == AmbiguityChoice::kBest ? *view.location.alternative_world_from_cam
-                                                          : view.location.world_from_cam;
+    const Rigid3 other = choice == AmbiguityChoice::kBest
+                             ? *view.location.alternative_world_from_cam
+                             : view.location.world_from_cam;
     EXPECT_LT(DegreesBetween(chosen, view.world_from_cam),
               DegreesBetween(other, view.world_from_cam));
   }
-  std::printf("0.3 px noise: %d ambiguous views, %d settled, %d by the second solution\n",
-              views, settled, alternatives);
+  std::printf("0.3 px noise: %d ambiguous views, %d settled, %d by the second solution\n", views,
+              settled, alternatives);
   // Measured: 40 ambiguous, 10 settled (2 by the second solution); the other 30 have their
   // solutions too close together (about 8 degrees) for either to stand out.
   EXPECT_GE(settled, 5);

@@ -174,6 +174,9 @@ void VisitOptions(CameraLocatorOptions& o, Visitor& visit) {
   visit("min_inlier_corners", o.min_inlier_corners, "fewer inlier corners: no pose");
   visit("refine_max_iterations", o.refine_max_iterations,
         "Levenberg-Marquardt iterations (0: no refinement)");
+  visit("max_view_angle_deg", o.max_view_angle_deg,
+        "a pose showing a marker from behind or more edge-on than this explains none of it, "
+        "degrees");
   visit("marker_pose", o.marker_pose, "per-marker IPPE and its ambiguity test");
 }
 

@@ -26,9 +26,9 @@ double Degrees(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
 // Three markers on the wall x = 10 m, facing back down the corridor (-x).
 MarkerMap EndWall() {
   MarkerMap map;
-  // Marker z (its normal, out of the front) along -x; marker x along +y, y along +z.
+  // Marker z (its normal, out of the front) along -x; marker x along -y, y along +z.
   Eigen::Matrix3d axes;
-  axes.col(0) = Eigen::Vector3d::UnitY();
+  axes.col(0) = -Eigen::Vector3d::UnitY();
   axes.col(1) = Eigen::Vector3d::UnitZ();
   axes.col(2) = -Eigen::Vector3d::UnitX();
   for (int id = 0; id < 3; ++id) {
