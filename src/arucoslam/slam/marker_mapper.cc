@@ -11,6 +11,24 @@ namespace {
 // Two marker orientations this far apart are different IPPE branches, radians.
 constexpr double kDistinctRotationRad = 0.1;
 
+// Whether a camera at `cam_from_world` can have detected `landmark`: the marker ahead of it,
+// its printed side towards the camera within 85 degrees (as the camera locator's default),
+// and its centre projected within one image size of the image (room for a drifted pose). A
+// misread elsewhere in the image fails this; local BA would move the keyframe to fit it.
+bool CouldHaveSeen(const MarkerLandmark& landmark, const Rigid3& cam_from_world,
+                   const CameraModel& camera) {
+  const Eigen::Vector3d centre_in_cam = cam_from_world * landmark.world_from_marker.translation;
+  if (!(centre_in_cam.z() > 0.0)) return false;
+  const Eigen::Vector3d to_camera =
+      cam_from_world.Inverse().translation - landmark.world_from_marker.translation;
+  const Eigen::Vector3d normal = landmark.world_from_marker.rotation * Eigen::Vector3d::UnitZ();
+  if (!(normal.dot(to_camera) > std::cos(85.0 * M_PI / 180.0) * to_camera.norm())) return false;
+  const double u = camera.fx * centre_in_cam.x() / centre_in_cam.z() + camera.cx;
+  const double v = camera.fy * centre_in_cam.y() / centre_in_cam.z() + camera.cy;
+  return u > -camera.width && u < 2.0 * camera.width && v > -camera.height &&
+         v < 2.0 * camera.height;
+}
+
 }  // namespace
 
 MarkerMapper::MarkerMapper(const MarkerMap& known, const MarkerMapperOptions& options)
@@ -34,8 +52,10 @@ std::vector<MarkerId> MarkerMapper::AddKeyframe(KeyframeId keyframe, const Rigid
   records_[record] = {keyframe, generation_, cam_from_world, camera, markers};
   std::vector<MarkerId> initialised;
   for (const MarkerObservation& observation : markers) {
-    if (landmarks_.Contains(observation.marker_id)) {
-      landmarks_.AddObservation(observation.marker_id, keyframe, observation.corners_px);
+    if (const MarkerLandmark* landmark = landmarks_.Find(observation.marker_id)) {
+      if (CouldHaveSeen(*landmark, cam_from_world, camera)) {
+        landmarks_.AddObservation(observation.marker_id, keyframe, observation.corners_px);
+      }
     } else if (unknown_size_ > 0.0) {
       Observe(record, observation, &initialised);
     }
@@ -62,9 +82,8 @@ bool MarkerMapper::WantsMarkerView(const Rigid3& cam_from_world,
     if (record.generation != kMarkerViewGeneration) continue;
     const bool near =
         (record.cam_from_world.Inverse().translation - centre).norm() < min_translation;
-    const bool turned =
-        RotationAngle(record.cam_from_world.rotation * cam_from_world.rotation.inverse()) >=
-        min_rotation;
+    const bool turned = RotationAngle(record.cam_from_world.rotation *
+                                      cam_from_world.rotation.inverse()) >= min_rotation;
     if (near && !turned) return false;
   }
   return true;
@@ -171,8 +190,7 @@ int MarkerMapper::CloseMap() {
   return generation_++;
 }
 
-int MarkerMapper::ReviveClosedMap(int generation,
-                                  const std::map<KeyframeId, KeyframeId>& new_ids) {
+int MarkerMapper::ReviveClosedMap(int generation, const std::map<KeyframeId, KeyframeId>& new_ids) {
   int revived = 0;
   for (auto& [index, record] : records_) {
     if (record.generation != generation || record.keyframe.IsValid()) continue;

@@ -341,16 +341,15 @@ TEST(MarkerMapperTest, RefineMarkersTurnsAMarkerOutOfAWrongOrientation) {
   const MarkerId wrong(1);
   const MarkerLandmark* landmark = mapper.landmarks().Find(wrong);
   ASSERT_NE(landmark, nullptr);
-  const Rigid3 turned(
-      landmark->world_from_marker.rotation *
-          Eigen::Quaterniond(Eigen::AngleAxisd(1.2, Eigen::Vector3d::UnitX())),
-      landmark->world_from_marker.translation);
+  const Rigid3 turned(landmark->world_from_marker.rotation *
+                          Eigen::Quaterniond(Eigen::AngleAxisd(1.2, Eigen::Vector3d::UnitX())),
+                      landmark->world_from_marker.translation);
   mapper.mutable_landmarks()->SetPose(wrong, turned);
   ASSERT_TRUE(mapper.RefineMarkers().success);
   const Eigen::Quaterniond& truth = scene.truth.markers[wrong.value].world_from_marker.rotation;
-  EXPECT_LT(RotationAngle(mapper.landmarks().Find(wrong)->world_from_marker.rotation *
-                          truth.inverse()),
-            0.05);
+  EXPECT_LT(
+      RotationAngle(mapper.landmarks().Find(wrong)->world_from_marker.rotation * truth.inverse()),
+      0.05);
   EXPECT_LT(PositionError(*mapper.landmarks().Find(wrong), scene.truth), 0.01);
 }
 
@@ -441,6 +440,44 @@ TEST(MarkerMapperTest, FalseDetectionsAreNotMapped) {
   EXPECT_EQ(output.markers.count(34), 0u);
   // The real markers are all mapped.
   EXPECT_EQ(output.markers.size(), scene.truth.markers.size());
+}
+
+TEST(MarkerMapperTest, AKeyframeKeepsOnlyDetectionsOfMarkersItCouldHaveSeen) {
+  // A known marker on a wall facing +y at x = 11.8 m; a camera 1.5 m from the wall looking
+  // along -x passes it. Ahead of it the marker is readable; beside the camera (out of its
+  // view) a detection with that id is a misread, and so is one seen from behind the wall.
+  MarkerMap known;
+  MarkerInfo info;
+  info.id = 17;
+  info.size = 0.2;
+  Eigen::Matrix3d axes;  // marker x along -x, y along +z, its normal along +y
+  axes.col(0) = -Eigen::Vector3d::UnitX();
+  axes.col(1) = Eigen::Vector3d::UnitZ();
+  axes.col(2) = Eigen::Vector3d::UnitY();
+  info.world_from_marker = Rigid3(Eigen::Quaterniond(axes), Eigen::Vector3d(11.8, 0.0, 0.6));
+  known.markers[info.id] = info;
+  const CameraModel camera = PinholeCamera(640, 480, 460.0);
+  Eigen::Matrix3d look_west;  // camera x = world +y, y = -world z, z = -world x
+  look_west.col(0) = Eigen::Vector3d::UnitY();
+  look_west.col(1) = -Eigen::Vector3d::UnitZ();
+  look_west.col(2) = -Eigen::Vector3d::UnitX();
+  auto cam_at = [&](double x, double y) {
+    return Rigid3(Eigen::Quaterniond(look_west), Eigen::Vector3d(x, y, 0.6)).Inverse();
+  };
+  MarkerObservation sliver;
+  sliver.marker_id = MarkerId{17};
+  sliver.corners_px = {Eigen::Vector2d(300, 230), Eigen::Vector2d(304, 230),
+                       Eigen::Vector2d(304, 247), Eigen::Vector2d(300, 247)};
+  MarkerMapperOptions options;
+  options.map_unknown = false;
+  MarkerMapper mapper(known, options);
+  mapper.AddKeyframe(KeyframeId{1}, cam_at(16.0, 1.5), camera, {sliver});   // ahead: kept
+  mapper.AddKeyframe(KeyframeId{2}, cam_at(12.1, 1.5), camera, {sliver});   // beside: not
+  mapper.AddKeyframe(KeyframeId{3}, cam_at(16.0, -1.5), camera, {sliver});  // behind: not
+  const MarkerLandmark* landmark = mapper.landmarks().Find(MarkerId{17});
+  ASSERT_NE(landmark, nullptr);
+  EXPECT_EQ(landmark->observations.size(), 1u);
+  EXPECT_EQ(landmark->observations.count(KeyframeId{1}), 1u);
 }
 
 }  // namespace
