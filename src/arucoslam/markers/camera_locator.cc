@@ -28,11 +28,9 @@ struct Correspondences {
   std::vector<cv::Point3d> in_world;
   std::vector<cv::Point2d> normalised;
   std::vector<Eigen::Vector2d> pixels;
-  std::vector<int> marker_ids;  // per corner
-  // Per corner: its marker's centre and printed side's normal, in the world.
-  std::vector<Eigen::Vector3d> marker_centres;
-  std::vector<Eigen::Vector3d> marker_normals;
-  double min_view_cosine = 0.0;  // cos(max_view_angle_deg)
+  std::vector<int> marker_ids;             // per corner
+  std::vector<Rigid3> world_from_markers;  // per corner, its marker's pose
+  double min_view_cosine = 0.0;            // cos(max_view_angle_deg)
 };
 
 struct Score {
@@ -51,8 +49,9 @@ std::vector<double> PixelErrors(const Correspondences& c, const CameraModel& cam
   const Rigid3 cam_from_world = world_from_cam.Inverse();
   std::vector<double> errors(c.pixels.size(), std::numeric_limits<double>::infinity());
   for (size_t i = 0; i < c.pixels.size(); ++i) {
-    const Eigen::Vector3d to_camera = world_from_cam.translation - c.marker_centres[i];
-    if (!(c.marker_normals[i].dot(to_camera) > c.min_view_cosine * to_camera.norm())) continue;
+    if (!SeesPrintedSide(c.world_from_markers[i], world_from_cam.translation, c.min_view_cosine)) {
+      continue;
+    }
     const Eigen::Vector3d p(c.in_world[i].x, c.in_world[i].y, c.in_world[i].z);
     const auto projected = camera.Project(cam_from_world * p);
     if (projected) errors[i] = (*projected - c.pixels[i]).norm();
@@ -105,10 +104,8 @@ void CollectKnownCorners(const std::vector<MarkerDetection>& detections, const M
       continue;
     }
     const std::array<Eigen::Vector3d, 4> in_world = info->CornersInWorld();
-    const Eigen::Vector3d normal = info->world_from_marker.rotation * Eigen::Vector3d::UnitZ();
     for (int k = 0; k < 4; ++k) {
-      c.marker_centres.push_back(info->world_from_marker.translation);
-      c.marker_normals.push_back(normal);
+      c.world_from_markers.push_back(info->world_from_marker);
       const Eigen::Vector2d xy = camera.Unproject(detection.corners[k]);
       c.in_world.emplace_back(in_world[k].x(), in_world[k].y(), in_world[k].z());
       c.normalised.emplace_back(xy.x(), xy.y());

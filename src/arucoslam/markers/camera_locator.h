@@ -24,8 +24,8 @@ struct CameraLocatorOptions {
   // A pose that would show a detected marker from behind, or more edge-on than this angle
   // between its printed side's normal and the line of sight, explains none of its corners:
   // no detector reads a marker there, but a misread sliver fits such a degenerate pose.
-  double max_view_angle_deg = 85.0;  // (0, 90]
-  MarkerPoseOptions marker_pose;     // per-marker IPPE and its ambiguity test
+  double max_view_angle_deg = kMaxReadableViewAngleDeg;  // (0, 90]
+  MarkerPoseOptions marker_pose;                         // per-marker IPPE and its ambiguity test
 
   bool Check(std::string* why = nullptr) const;
 };

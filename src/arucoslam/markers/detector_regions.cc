@@ -16,8 +16,7 @@ std::vector<PixelQuad> ProjectMarkerQuads(const MarkerMap& markers, const Camera
   const Eigen::Vector3d camera_in_world = cam_from_world.Inverse().translation;
   std::vector<PixelQuad> quads;
   for (const auto& [id, marker] : markers.markers) {
-    const Eigen::Vector3d normal = marker.world_from_marker.rotation * Eigen::Vector3d::UnitZ();
-    if (normal.dot(camera_in_world - marker.world_from_marker.translation) <= 0.0) continue;
+    if (!SeesPrintedSide(marker.world_from_marker, camera_in_world, 0.0)) continue;
     PixelQuad quad;
     bool in_front = true;
     const std::array<Eigen::Vector3d, 4> corners = marker.CornersInWorld();

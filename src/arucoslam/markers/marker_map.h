@@ -23,6 +23,16 @@ struct MarkerInfo {
   std::array<Eigen::Vector3d, 4> CornersInWorld() const;
 };
 
+// The largest angle between a marker's printed-side normal and the line of sight at which a
+// detector still reads it: beyond it the marker is a sliver, and a detection there a misread.
+inline constexpr double kMaxReadableViewAngleDeg = 85.0;
+
+// Whether a camera centred at `camera_in_world` sees the printed side (the marker frame's +z)
+// of a marker at `world_from_marker`: the cosine of the angle between that normal and the line
+// of sight above `min_view_cosine` (0: anywhere in front of the marker).
+bool SeesPrintedSide(const Rigid3& world_from_marker, const Eigen::Vector3d& camera_in_world,
+                     double min_view_cosine);
+
 struct MarkerMap {
   std::string dictionary = "DICT_4X4_50";
   std::string frame = "world";

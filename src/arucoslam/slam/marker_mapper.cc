@@ -12,17 +12,18 @@ namespace {
 constexpr double kDistinctRotationRad = 0.1;
 
 // Whether a camera at `cam_from_world` can have detected `landmark`: the marker ahead of it,
-// its printed side towards the camera within 85 degrees (as the camera locator's default),
-// and its centre projected within one image size of the image (room for a drifted pose). A
-// misread elsewhere in the image fails this; local BA would move the keyframe to fit it.
+// its printed side readable (kMaxReadableViewAngleDeg), and its centre projected within one
+// image size of the image (room for a drifted pose). A misread elsewhere in the image fails
+// this; local BA would move the keyframe to fit it.
 bool CouldHaveSeen(const MarkerLandmark& landmark, const Rigid3& cam_from_world,
                    const CameraModel& camera) {
   const Eigen::Vector3d centre_in_cam = cam_from_world * landmark.world_from_marker.translation;
   if (!(centre_in_cam.z() > 0.0)) return false;
-  const Eigen::Vector3d to_camera =
-      cam_from_world.Inverse().translation - landmark.world_from_marker.translation;
-  const Eigen::Vector3d normal = landmark.world_from_marker.rotation * Eigen::Vector3d::UnitZ();
-  if (!(normal.dot(to_camera) > std::cos(85.0 * M_PI / 180.0) * to_camera.norm())) return false;
+  const double min_view_cosine = std::cos(kMaxReadableViewAngleDeg * M_PI / 180.0);
+  if (!SeesPrintedSide(landmark.world_from_marker, cam_from_world.Inverse().translation,
+                       min_view_cosine)) {
+    return false;
+  }
   const double u = camera.fx * centre_in_cam.x() / centre_in_cam.z() + camera.cx;
   const double v = camera.fy * centre_in_cam.y() / centre_in_cam.z() + camera.cy;
   return u > -camera.width && u < 2.0 * camera.width && v > -camera.height &&
