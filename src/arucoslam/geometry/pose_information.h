@@ -19,4 +19,15 @@ inline Matrix6d IsotropicPoseInformation(double position_sigma_m, double rotatio
   return information;
 }
 
+// Standard deviation, metres, of the camera centre along its least certain direction: the
+// square root of the largest eigenvalue of the centre block of information^-1. A diagonal
+// `information` gives 1 / sqrt of its smallest centre entry, exactly.
+double LeastCertainPositionSigma(const Matrix6d& information);
+
+// The information of a prior whose covariance is that of `information` plus a diagonal floor
+// (`floor_variances`, all > 0): (information^-1 + floor)^-1, computed without inverting a
+// singular `information`, so a prior is never firmer than the floor allows.
+Matrix6d WithCovarianceFloor(const Matrix6d& information,
+                             const Eigen::Matrix<double, 6, 1>& floor_variances);
+
 }  // namespace arucoslam

@@ -7,8 +7,10 @@
 #include <optional>
 #include <utility>
 
+#include "arucoslam/geometry/pose_information.h"
 #include "arucoslam/markers/marker_pose.h"
 #include "arucoslam/optim/marker_corner_error.h"
+#include "arucoslam/optim/marker_location_information.h"
 #include "arucoslam/optim/marker_pose_optimizer.h"
 
 namespace arucoslam {
@@ -89,7 +91,7 @@ std::vector<PositionPrior> PositionPriorsOf(const std::vector<KeyframePosePrior>
     const auto it = std::find(keyframe_ids.begin(), keyframe_ids.end(), prior.keyframe);
     if (it == keyframe_ids.end() || !(prior.information(0, 0) > 0.0)) continue;
     out.push_back({static_cast<std::size_t>(it - keyframe_ids.begin()),
-                   prior.world_from_cam.translation, 1.0 / std::sqrt(prior.information(0, 0))});
+                   prior.world_from_cam.translation, LeastCertainPositionSigma(prior.information)});
   }
   return out;
 }
@@ -103,19 +105,24 @@ int ApplyMarkerFactors(const MarkerFactors& factors, MarkerLandmarks* landmarks)
   return moved;
 }
 
-Matrix6d MarkerPriorInformation(const MarkerFactorOptions& options, double nearest_marker_sides,
-                                double num_markers) {
-  double growth = 1.0;  // variance factor for the distance
-  if (options.prior_reference_distance_sides > 0.0) {
-    const double ratio = nearest_marker_sides / options.prior_reference_distance_sides;
-    growth = std::max(1.0, ratio * ratio * ratio * ratio);
+Matrix6d MarkerPriorInformation(const MarkerFactorOptions& options, double num_markers,
+                                const Matrix6d& corner_information) {
+  const double position_sigma_squared =
+      options.prior_position_sigma_m * options.prior_position_sigma_m;
+  const double rotation_sigma_squared =
+      options.prior_rotation_sigma_rad * options.prior_rotation_sigma_rad;
+  if (!options.prior_from_corners) {
+    Matrix6d information = Matrix6d::Zero();
+    information.diagonal() << Eigen::Vector3d::Constant(num_markers / position_sigma_squared),
+        Eigen::Vector3d::Constant(num_markers / rotation_sigma_squared);
+    return information;
   }
-  Matrix6d information = Matrix6d::Zero();
-  information.diagonal() << Eigen::Vector3d::Constant(
-      num_markers / (growth * options.prior_position_sigma_m * options.prior_position_sigma_m)),
-      Eigen::Vector3d::Constant(num_markers / (growth * options.prior_rotation_sigma_rad *
-                                               options.prior_rotation_sigma_rad));
-  return information;
+  const double position_variance = position_sigma_squared / num_markers;
+  const double rotation_variance = rotation_sigma_squared / num_markers;
+  Eigen::Matrix<double, 6, 1> floor;
+  floor << Eigen::Vector3d::Constant(position_variance),
+      Eigen::Vector3d::Constant(rotation_variance);
+  return WithCovarianceFloor(corner_information, floor);
 }
 
 std::vector<PoseGraphProblem::PosePrior> MarkerPosePriors(const MapData& data,
@@ -182,7 +189,17 @@ std::vector<PoseGraphProblem::PosePrior> MarkerPosePriors(const MapData& data,
     PoseGraphProblem::PosePrior prior;
     prior.node = node;
     prior.world_from_cam = result.cam_from_world.Inverse();
-    prior.information = MarkerPriorInformation(options, nearest_sides, result.num_marker_inliers);
+    Matrix6d corner_information = Matrix6d::Zero();
+    if (options.prior_from_corners) {
+      std::vector<MarkerPoseObservation> inliers;
+      for (std::size_t i = 0; i < it->second.size(); ++i) {
+        if (result.marker_inliers[i]) inliers.push_back(it->second[i]);
+      }
+      corner_information = MarkerLocationInformation(
+          prior.world_from_cam, inliers, PinholeIntrinsics::FromCamera(keyframe->camera));
+    }
+    prior.information =
+        MarkerPriorInformation(options, result.num_marker_inliers, corner_information);
     priors.push_back(prior);
   }
   return priors;

@@ -26,11 +26,11 @@ struct MarkerFactorOptions {
   int min_prior_markers = 1;
   double prior_position_sigma_m = 0.05;
   double prior_rotation_sigma_rad = 0.02;
-  // A marker pose's error grows with the square of its distance: when > 0, both sigmas are
-  // for a camera this many marker sides from its nearest marker and grow as (distance / it)^2
-  // beyond (never shrink below). Priors farther than max_prior_distance_sides (> 0) are left out.
-  double prior_reference_distance_sides = 0.0;
+  // Priors farther than this many marker sides from their nearest marker are left out (> 0).
   double max_prior_distance_sides = 0.0;
+  // true: a prior's covariance is its corners' own (MarkerLocationInformation: it grows with
+  // the distance, the view angle and fewer markers) plus the sigmas above as a floor.
+  bool prior_from_corners = false;
 
   bool Check(std::string* why = nullptr) const {
     OptionCheck check(why);
@@ -40,7 +40,6 @@ struct MarkerFactorOptions {
     check.AtLeast("min_prior_markers", min_prior_markers, 1);
     check.Above("prior_position_sigma_m", prior_position_sigma_m, 0.0);
     check.Above("prior_rotation_sigma_rad", prior_rotation_sigma_rad, 0.0);
-    check.AtLeast("prior_reference_distance_sides", prior_reference_distance_sides, 0.0);
     check.AtLeast("max_prior_distance_sides", max_prior_distance_sides, 0.0);
     return check.ok();
   }
@@ -85,11 +84,11 @@ std::vector<PositionPrior> PositionPriorsOf(const std::vector<KeyframePosePrior>
 // Writes the solved poses of non-fixed markers back into `landmarks`; returns how many.
 int ApplyMarkerFactors(const MarkerFactors& factors, MarkerLandmarks* landmarks);
 
-// Information of a marker pose prior over [centre, metres; rotation, radians]: `num_markers`
-// markers seen from `nearest_marker_sides` marker sides (the options' sigmas, grown with
-// distance as prior_reference_distance_sides says).
-Matrix6d MarkerPriorInformation(const MarkerFactorOptions& options, double nearest_marker_sides,
-                                double num_markers);
+// Information of a marker pose prior over [centre, metres; rotation, radians] of `num_markers`
+// markers: the options' sigmas divided by sqrt(num_markers); with prior_from_corners, the
+// covariance of `corner_information` (MarkerLocationInformation of their corners) plus that.
+Matrix6d MarkerPriorInformation(const MarkerFactorOptions& options, double num_markers,
+                                const Matrix6d& corner_information);
 
 // Absolute pose priors for a pose graph (node i is keyframe_ids[i]): for each keyframe that
 // sees at least min_prior_markers fixed markers, its pose from those markers' corners alone

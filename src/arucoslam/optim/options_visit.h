@@ -43,10 +43,10 @@ void VisitOptions(MarkerFactorOptions& o, Visitor& visit) {
         "pose prior position sigma per marker seen, metres");
   visit("prior_rotation_sigma_rad", o.prior_rotation_sigma_rad,
         "pose prior rotation sigma per marker seen, radians");
-  visit("prior_reference_distance_sides", o.prior_reference_distance_sides,
-        "> 0: the sigmas hold at this many marker sides and grow with distance^2 beyond");
   visit("max_prior_distance_sides", o.max_prior_distance_sides,
         "> 0: priors farther than this many marker sides are left out");
+  visit("prior_from_corners", o.prior_from_corners,
+        "true: a prior's covariance is its marker corners' own plus the sigmas above");
 }
 
 template <class Visitor>

@@ -117,6 +117,9 @@ bool InitializerOptions::Check(std::string* why) const {
   check.AtLeast("min_triangulated", min_triangulated, 1);
   check.InRange("min_triangulated_fraction", min_triangulated_fraction, 0.0, 1.0,
                 Interval::kClosed);
+  check.Above("relax_after_s", relax_after_s, 0.0);
+  check.InRange("relaxed_triangulated_fraction", relaxed_triangulated_fraction, 0.0, 1.0,
+                Interval::kClosed);
   check.InRange("ambiguity_ratio", ambiguity_ratio, 0.0, 1.0, Interval::kOpen);
   check.InRange("min_epipolar_support_ratio", min_epipolar_support_ratio, 0.0, 1.0,
                 Interval::kClosed);

@@ -32,6 +32,12 @@ struct InitializerOptions {
   double max_reprojection_px = 2.0;        // per view, for a triangulated point to count
   int min_triangulated = 50;               // absolute minimum of good points
   double min_triangulated_fraction = 0.9;  // of the chosen model's inliers
+  // A start facing depth (a vehicle leaving from rest down an aisle) keeps its far points below
+  // the parallax that triangulates them, and the 90% share above can take seconds to reach.
+  // After this many seconds on one reference (MapInitializer), an unambiguous motion needs
+  // only relaxed_triangulated_fraction of good points.
+  double relax_after_s = 2.5;
+  double relaxed_triangulated_fraction = 0.8;
   // kAmbiguous when the second-best motion is consistent with more than this fraction of
   // the points the best explains. With F the wrong motions explain almost nothing; with H the
   // second physical solution of the plane typically keeps 70-80% of the points in front of

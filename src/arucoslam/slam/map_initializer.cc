@@ -20,6 +20,11 @@ MapInitializer::MapInitializer(const CameraModel& camera, const MapInitializerOp
     : camera_(camera),
       options_(options),
       two_view_(options.two_view),
+      relaxed_two_view_([&] {
+        InitializerOptions relaxed = options.two_view;
+        relaxed.min_triangulated_fraction = relaxed.relaxed_triangulated_fraction;
+        return relaxed;
+      }()),
       markers_(options.markers, options.two_view, options.initial_map) {}
 
 InitializationStep MapInitializer::Step(Map& map, Frame& frame, const std::optional<MarkerFix>& fix,
@@ -33,8 +38,11 @@ InitializationStep MapInitializer::Step(Map& map, Frame& frame, const std::optio
   }
   step.attempted = true;
   if (fix && TryMarkers(map, frame, *fix, frame_index, &step)) return step;
+  const bool waited =
+      frame.timestamp_s - reference_->timestamp_s >= options_.two_view.relax_after_s;
   const InitializationResult result =
-      two_view_.Initialize(reference_->features, frame.features, camera_);
+      (waited ? relaxed_two_view_ : two_view_)
+          .Initialize(reference_->features, frame.features, camera_);
   step.message = result.message;
   ARUCOSLAM_LOG_DEBUG("frame {}: initialisation {}: {}", frame_index,
                       result.success ? "succeeded" : InitFailureName(result.failure),

@@ -76,6 +76,7 @@ class MapInitializer {
   CameraModel camera_;
   MapInitializerOptions options_;
   Initializer two_view_;
+  Initializer relaxed_two_view_;  // two_view_ with relaxed_triangulated_fraction
   MarkerInitializer markers_;
   std::optional<Frame> reference_;
   std::optional<MarkerFix> reference_fix_;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <map>
 #include <vector>
 
 #include "arucoslam/geometry/camera.h"
@@ -86,6 +87,48 @@ TEST_F(MapInitializerTest, AFrameWithoutParallaxGoesToTheBackfillAndTheReference
   EXPECT_EQ(step.for_backfill->timestamp_s, 0.5);
   EXPECT_EQ(map_.NumKeyframes(), 0u);
   EXPECT_EQ(ReferenceOfTheMap(1.0, 0.0), 0.0);
+}
+
+TEST_F(MapInitializerTest, AfterWaitingOnOneReferenceASmallerShareOfGoodPointsSuffices) {
+  // A fifth of the points move along their epipolar lines against the camera's motion (seen
+  // from the second frame they lie behind it): still inliers of the two-view geometry, but
+  // not good points. Before relax_after_s 90% must be good, afterwards 70%.
+  MapInitializerOptions options;
+  options.two_view.relax_after_s = 2.5;
+  options.two_view.relaxed_triangulated_fraction = 0.7;
+  MapInitializer initializer(scene_.camera(), options);
+  std::vector<int> reference_truth;
+  Frame reference = scene_.MakeFrame(FrameId(next_id_++), 0.0, Rigid3(), &reference_truth);
+  std::map<int, Eigen::Vector2d> reference_pixel;  // point index -> normalised, in the reference
+  for (std::size_t i = 0; i < reference_truth.size(); ++i) {
+    if (reference_truth[i] >= 0)
+      reference_pixel[reference_truth[i]] = reference.features.undistorted[i];
+  }
+  initializer.Step(map_, reference, std::nullopt, 0);
+  auto moved_frame = [&](double timestamp_s) {
+    std::vector<int> truth;
+    const Rigid3 cam_from_world(Eigen::Quaterniond::Identity(), Eigen::Vector3d(-0.6, 0.0, 0.0));
+    Frame frame = scene_.MakeFrame(FrameId(next_id_++), timestamp_s, cam_from_world, &truth);
+    for (std::size_t i = 0; i < truth.size(); ++i) {
+      const auto seen = reference_pixel.find(truth[i]);
+      if (truth[i] < 0 || truth[i] % 5 != 0 || seen == reference_pixel.end()) continue;
+      // The disparity reversed (normalised x' = 2 x_reference - x), in pixels too.
+      Eigen::Vector2d& normalised = frame.features.undistorted[i];
+      const double shift = 2.0 * (seen->second.x() - normalised.x());
+      normalised.x() += shift;
+      frame.features.keypoints[i].pt.x += static_cast<float>(scene_.camera().fx * shift);
+    }
+    return frame;
+  };
+  Frame early = moved_frame(2.0);
+  const InitializationStep refused = initializer.Step(map_, early, std::nullopt, 1);
+  EXPECT_TRUE(refused.attempted);
+  EXPECT_FALSE(refused.map.has_value());
+  EXPECT_NE(refused.message.find("consistent"), std::string::npos) << refused.message;
+  Frame late = moved_frame(2.6);
+  const InitializationStep built = initializer.Step(map_, late, std::nullopt, 2);
+  ASSERT_TRUE(built.map.has_value()) << built.message;
+  EXPECT_EQ(built.map->first.timestamp_s, 0.0);
 }
 
 TEST_F(MapInitializerTest, TooFewFeaturesNeverMakeAReference) {

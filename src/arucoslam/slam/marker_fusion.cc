@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "arucoslam/optim/marker_corner_error.h"
+#include "arucoslam/optim/marker_location_information.h"
 #include "arucoslam/util/logging.h"
 #include "arucoslam/util/option_check.h"
 
@@ -126,7 +127,6 @@ const std::optional<MarkerFix>& MarkerFusion::Locate(const std::vector<MarkerDet
   const Rigid3 world_from_cam = resolved ? *ChosenPose(location, choice) : location.world_from_cam;
   fix_ = MakeFix(location, world_from_cam, detections, locating);
   fix_->settled_ambiguity = resolved;
-  fix_->nearest_marker_sides = nearest_sides;
   fix_motion_.Add(timestamp_s, fix_->world_from_cam);
   ++stats_.num_located_frames;
   if (resolved) {
@@ -160,6 +160,8 @@ MarkerFix MarkerFusion::MakeFix(const CameraLocation& location, const Rigid3& wo
     observation.corners_px = UndistortedCorners(camera_, detection.corners);
     fix.markers.push_back(observation);
   }
+  fix.corner_information = MarkerLocationInformation(world_from_cam, fix.markers,
+                                                     PinholeIntrinsics::FromCamera(camera_));
   return fix;
 }
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "arucoslam/geometry/camera.h"
+#include "arucoslam/geometry/pose_information.h"
 #include "arucoslam/geometry/rigid3.h"
 #include "arucoslam/geometry/world_motion_prior.h"
 #include "arucoslam/map/frame.h"
@@ -69,9 +70,11 @@ struct MarkerFusionOptions {
 struct MarkerFix {
   Rigid3 world_from_cam;
   std::vector<MarkerPoseObservation> markers;  // its inlier markers, undistorted corners
-  double nearest_marker_sides = 0.0;           // camera to its nearest marker, in sides
   bool known_markers_only = true;              // located by the known map's fixed markers alone
   bool settled_ambiguity = false;  // one ambiguous marker, settled by a prediction or vote
+  // How firmly the markers' corners fix world_from_cam (MarkerLocationInformation); zero
+  // when not computed.
+  Matrix6d corner_information = Matrix6d::Zero();
 };
 
 // What the keypoint map tells MarkerFusion about the frame being located.

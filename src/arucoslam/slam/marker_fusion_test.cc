@@ -130,8 +130,12 @@ TEST(MarkerFusionTest, LocatesTheCameraFromSeveralMarkers) {
   EXPECT_EQ(fix->markers.size(), 4u);
   EXPECT_TRUE(fix->known_markers_only);
   EXPECT_FALSE(fix->settled_ambiguity);
-  // The nearest marker is about 2 m / 0.15 m away.
-  EXPECT_NEAR(fix->nearest_marker_sides, 13.5, 1.0);
+  // Its corners' information: millimetres to centimetres 2 m from the board, and the located
+  // centre within three of its standard deviations of the truth.
+  const double sigma = LeastCertainPositionSigma(fix->corner_information);
+  EXPECT_GT(sigma, 1e-3);
+  EXPECT_LT(sigma, 0.05);
+  EXPECT_LT((fix->world_from_cam.translation - truth.translation).norm(), 3.0 * sigma);
   // The fix's markers carry their world poses and the corners as seen (no distortion here).
   EXPECT_LT((fix->markers[0].world_from_marker.translation - WorldFromMarker(0).translation).norm(),
             1e-12);

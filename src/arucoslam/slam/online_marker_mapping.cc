@@ -145,10 +145,10 @@ EssentialGraphResult OnlineMarkerMapping::CorrectDrift(Map* map, KeyframeId keyf
   const EssentialGraphResult result =
       OptimizeEssentialGraph(*map, KeyframeId(), {}, {}, decision.priors, graph);
   ARUCOSLAM_LOG_DEBUG(
-      "keyframe {}: {:.3f} m from its markers (sigma {:.3f} m), map corrected "
+      "keyframe {}: {:.3f} m from its markers ({:.1f} sigmas), map corrected "
       "over {} keyframes with {} marker priors: {}",
-      keyframe.value, decision.offset_m, decision.sigma_m, result.num_keyframes, result.num_priors,
-      result.summary.BriefReport());
+      keyframe.value, decision.offset_m, decision.offset_sigmas, result.num_keyframes,
+      result.num_priors, result.summary.BriefReport());
   return result;
 }
 

@@ -45,6 +45,10 @@ void VisitOptions(InitializerOptions& o, Visitor& visit) {
   visit("min_triangulated", o.min_triangulated, "good triangulated points at least");
   visit("min_triangulated_fraction", o.min_triangulated_fraction,
         "good points at least this fraction of the chosen model's inliers");
+  visit("relax_after_s", o.relax_after_s,
+        "after this long on one reference, seconds, an unambiguous motion needs only ...");
+  visit("relaxed_triangulated_fraction", o.relaxed_triangulated_fraction,
+        "... this fraction of good points");
   visit("ambiguity_ratio", o.ambiguity_ratio,
         "ambiguous when the second-best motion explains more than this fraction of the points");
   visit("min_epipolar_support_ratio", o.min_epipolar_support_ratio,

@@ -35,21 +35,21 @@ struct WorldAnchoringOptions {
   // After the first alignment, anchors keep being collected and the map is aligned again
   // (a small Sim3 correction) each time their number doubles, up to this many anchors.
   int max_realignment_anchors = 64;
-  // Drift correction: a keyframe of the aligned map whose pose from its known markers lies
-  // farther than min_marker_correction_m (metres) and than marker_correction_sigmas of that
-  // pose's standard deviation from its keypoint pose triggers a pose-graph correction of the
-  // whole map, with the marker pose of every keyframe that sees known markers as a prior.
-  // false: never.
+  // Drift correction: a keyframe of the aligned map whose keypoint pose lies farther than
+  // min_marker_correction_m (metres, its centre) and than marker_correction_sigmas standard
+  // deviations (the Mahalanobis distance over centre and rotation under marker_priors) from
+  // its pose from its known markers triggers a pose-graph correction of the whole map, with
+  // the marker pose of every keyframe that sees known markers as a prior. false: never.
   bool drift_correction = true;
   double min_marker_correction_m = 0.05;
   double marker_correction_sigmas = 3.0;
-  // A keyframe's marker location as a prior: 1 cm and 0.01 rad per marker (divided by
-  // sqrt(markers)) at 10 marker sides and nearer, growing with distance^2 beyond.
+  // A keyframe's marker location as a prior: the covariance its corners give (1 px noise) plus
+  // 1 cm and 0.01 rad per marker (divided by sqrt(markers)).
   MarkerFactorOptions marker_priors = [] {
     MarkerFactorOptions priors;
     priors.prior_position_sigma_m = 0.01;
     priors.prior_rotation_sigma_rad = 0.01;
-    priors.prior_reference_distance_sides = 10.0;
+    priors.prior_from_corners = true;
     return priors;
   }();
   // The pose graph of those corrections (and of loops and bridges corrected with the marker
@@ -89,8 +89,8 @@ struct AlignmentDecision {
 // A drift correction to make: the marker priors of the pose graph, and why (for the log).
 struct DriftCorrectionDecision {
   std::vector<KeyframePosePrior> priors;
-  double offset_m = 0.0;  // the keyframe's keypoint centre from its marker location, metres
-  double sigma_m = 0.0;   // that marker location's standard deviation, metres
+  double offset_m = 0.0;       // the keyframe's keypoint centre from its marker location, metres
+  double offset_sigmas = 0.0;  // its keypoint pose from that location, standard deviations
 };
 
 // One map's anchoring to the marker world. The tracking thread adds anchors and decides

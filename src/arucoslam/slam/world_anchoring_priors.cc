@@ -10,9 +10,9 @@ KeyframePosePrior WorldAnchoring::MarkerPrior(KeyframeId keyframe, const MarkerF
   KeyframePosePrior prior;
   prior.keyframe = keyframe;
   prior.world_from_cam = fix.world_from_cam;
-  prior.information =
-      MarkerPriorInformation(options_.marker_priors, fix.nearest_marker_sides,
-                             static_cast<double>(std::max<std::size_t>(1, fix.markers.size())));
+  prior.information = MarkerPriorInformation(
+      options_.marker_priors, static_cast<double>(std::max<std::size_t>(1, fix.markers.size())),
+      fix.corner_information);
   return prior;
 }
 
@@ -38,18 +38,24 @@ std::optional<DriftCorrectionDecision> WorldAnchoring::DecideDriftCorrection(
   }
   DriftCorrectionDecision decision;
   decision.priors = KnownMarkerPriors();
-  const std::optional<double> offset_m = map.Read([&](const MapData& data)
-                                                      -> std::optional<double> {
-    const Keyframe* found = data.FindKeyframe(keyframe);
-    if (found == nullptr) return std::nullopt;
-    return (own->world_from_cam.translation - found->cam_from_world.Inverse().translation).norm();
-  });
-  decision.sigma_m = 1.0 / std::sqrt(own->information(0, 0));
-  if (!offset_m || *offset_m < options_.min_marker_correction_m ||
-      *offset_m < options_.marker_correction_sigmas * decision.sigma_m) {
+  const std::optional<Rigid3> keypoint_pose =
+      map.Read([&](const MapData& data) -> std::optional<Rigid3> {
+        const Keyframe* found = data.FindKeyframe(keyframe);
+        if (found == nullptr) return std::nullopt;
+        return found->cam_from_world.Inverse();
+      });
+  if (!keypoint_pose) return std::nullopt;
+  // The keypoint pose's error as the marker prior measures it: centre, then rotation in the
+  // camera frame (PosePriorError's order).
+  Vector6d error;
+  error << keypoint_pose->translation - own->world_from_cam.translation,
+      LogSO3(own->world_from_cam.rotation.inverse() * keypoint_pose->rotation);
+  decision.offset_m = error.head<3>().norm();
+  decision.offset_sigmas = std::sqrt(std::max(0.0, error.dot(own->information * error)));
+  if (decision.offset_m < options_.min_marker_correction_m ||
+      decision.offset_sigmas < options_.marker_correction_sigmas) {
     return std::nullopt;
   }
-  decision.offset_m = *offset_m;
   return decision;
 }
 

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "arucoslam/geometry/pose_information.h"
+
 namespace arucoslam {
 namespace {
 
@@ -31,14 +33,15 @@ KeyframeId AddKeyframe(const Rigid3& world_from_cam, Map* map) {
   return map->Write([&](MapData& data) { return data.AddKeyframe(keyframe); });
 }
 
-// A marker location of one known marker seen from 5 marker sides, `shift` off the truth.
-MarkerFix Fix(const Rigid3& world_from_cam,
-              const Eigen::Vector3d& shift = Eigen::Vector3d::Zero()) {
+// A marker location of one known marker, `shift` off the truth, whose corners fix the camera
+// centre to `corner_sigma_m` (and its rotation to 5 mrad).
+MarkerFix Fix(const Rigid3& world_from_cam, const Eigen::Vector3d& shift = Eigen::Vector3d::Zero(),
+              double corner_sigma_m = 0.005) {
   MarkerFix fix;
   fix.world_from_cam = world_from_cam;
   fix.world_from_cam.translation += shift;
   fix.markers.resize(1);
-  fix.nearest_marker_sides = 5.0;
+  fix.corner_information = IsotropicPoseInformation(corner_sigma_m, 0.005);
   return fix;
 }
 
@@ -138,6 +141,7 @@ TEST(WorldAnchoring, DriftIsCorrectedBeyondFiveCentimetresAndThreeSigmas) {
   anchoring.AddAnchor(near, Fix(WorldFromCam(4), Eigen::Vector3d(0.04, 0.0, 0.0)));
   const KeyframeId far = AddKeyframe(WorldFromCam(5), &map);
   anchoring.AddAnchor(far, Fix(WorldFromCam(5), Eigen::Vector3d(0.2, 0.0, 0.0)));
+  const KeyframeId seen_far = AddKeyframe(WorldFromCam(6), &map);  // for a far marker below
   anchoring.AlignmentApplied(*anchoring.DecideAlignment(map));
   // The map frame is the world now.
   map.Write([](MapData& data) {
@@ -148,16 +152,24 @@ TEST(WorldAnchoring, DriftIsCorrectedBeyondFiveCentimetresAndThreeSigmas) {
   const std::optional<DriftCorrectionDecision> decision = anchoring.DecideDriftCorrection(map, far);
   ASSERT_TRUE(decision.has_value());
   EXPECT_NEAR(decision->offset_m, 0.2, 1e-6);
-  EXPECT_NEAR(decision->sigma_m, 0.01, 1e-12);  // one marker within 10 sides: 1 cm
+  // 20 cm over the corners' 5 mm and the 1 cm floor of one marker: sqrt(0.005^2 + 0.01^2).
+  EXPECT_NEAR(decision->offset_sigmas, 0.2 / std::sqrt(0.005 * 0.005 + 0.01 * 0.01), 1e-6);
   EXPECT_EQ(decision->priors.size(), 6u);
   // A prior of 10 cm: 20 cm is within three sigmas.
   WorldAnchoringOptions loose;
   loose.marker_priors.prior_position_sigma_m = 0.1;
   WorldAnchoring loose_anchoring(loose);
   loose_anchoring.AddKeyframeFixes(anchoring.KeyframeFixes());
-  EXPECT_NEAR(1.0 / std::sqrt(loose_anchoring.KnownMarkerPriors()[0].information(0, 0)), 0.1,
-              1e-12);
+  EXPECT_NEAR(LeastCertainPositionSigma(loose_anchoring.KnownMarkerPriors()[0].information),
+              std::sqrt(0.005 * 0.005 + 0.1 * 0.1), 1e-9);
   EXPECT_FALSE(loose_anchoring.DecideDriftCorrection(map, far).has_value());
+  // A far marker whose corners fix the centre to 10 cm: 20 cm is within three sigmas too.
+  WorldAnchoring far_marker_anchoring({});
+  far_marker_anchoring.AddAnchor(seen_far,
+                                 Fix(WorldFromCam(6), Eigen::Vector3d(0.2, 0.0, 0.0), 0.1));
+  EXPECT_FALSE(far_marker_anchoring.DecideDriftCorrection(map, seen_far).has_value());
+  far_marker_anchoring.AddAnchor(far, Fix(WorldFromCam(5), Eigen::Vector3d(0.2, 0.0, 0.0)));
+  EXPECT_TRUE(far_marker_anchoring.DecideDriftCorrection(map, far).has_value());
   // Switched off: no correction, however far.
   WorldAnchoringOptions off;
   off.drift_correction = false;
