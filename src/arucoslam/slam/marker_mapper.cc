@@ -12,14 +12,14 @@ namespace {
 constexpr double kDistinctRotationRad = 0.1;
 
 // Whether a camera at `cam_from_world` can have detected `landmark`: the marker ahead of it,
-// its printed side readable (kMaxReadableViewAngleDeg), and its centre projected within one
+// its printed side readable (within max_view_angle_deg), and its centre projected within one
 // image size of the image (room for a drifted pose). A misread elsewhere in the image fails
 // this; local BA would move the keyframe to fit it.
 bool CouldHaveSeen(const MarkerLandmark& landmark, const Rigid3& cam_from_world,
-                   const CameraModel& camera) {
+                   const CameraModel& camera, double max_view_angle_deg) {
   const Eigen::Vector3d centre_in_cam = cam_from_world * landmark.world_from_marker.translation;
   if (!(centre_in_cam.z() > 0.0)) return false;
-  const double min_view_cosine = std::cos(kMaxReadableViewAngleDeg * M_PI / 180.0);
+  const double min_view_cosine = std::cos(max_view_angle_deg * M_PI / 180.0);
   if (!SeesPrintedSide(landmark.world_from_marker, cam_from_world.Inverse().translation,
                        min_view_cosine)) {
     return false;
@@ -54,7 +54,7 @@ std::vector<MarkerId> MarkerMapper::AddKeyframe(KeyframeId keyframe, const Rigid
   std::vector<MarkerId> initialised;
   for (const MarkerObservation& observation : markers) {
     if (const MarkerLandmark* landmark = landmarks_.Find(observation.marker_id)) {
-      if (CouldHaveSeen(*landmark, cam_from_world, camera)) {
+      if (CouldHaveSeen(*landmark, cam_from_world, camera, options_.max_view_angle_deg)) {
         landmarks_.AddObservation(observation.marker_id, keyframe, observation.corners_px);
       }
     } else if (unknown_size_ > 0.0) {

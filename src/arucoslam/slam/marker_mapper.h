@@ -28,6 +28,9 @@ struct MarkerMapperOptions {
   bool map_unknown = true;
   // IPPE ambiguity test of a single view (see marker_pose.h).
   MarkerPoseOptions marker_pose;
+  // A keyframe's detection of a mapped marker is kept only when the keyframe's pose sees the
+  // marker's printed side within this angle of its normal, degrees (a misread elsewhere).
+  double max_view_angle_deg = kMaxReadableViewAngleDeg;
   // A first view whose best IPPE solution reprojects worse than this (RMS, pixels) is not
   // used to initialise (blurred or partly occluded corners).
   double max_initial_rms_px = 2.0;
@@ -69,6 +72,7 @@ struct MarkerMapperOptions {
     OptionCheck check(why);
     check.AtLeast("unknown_marker_size_m", unknown_marker_size_m, 0.0);
     check.Nested("marker_pose", marker_pose);
+    check.InRange("max_view_angle_deg", max_view_angle_deg, 0.0, 90.0, Interval::kOpenClosed);
     check.Above("max_initial_rms_px", max_initial_rms_px, 0.0);
     check.AtLeast("min_consistent_views", min_consistent_views, 2);
     check.Above("max_view_disagreement_m", max_view_disagreement_m, 0.0);

@@ -478,6 +478,12 @@ TEST(MarkerMapperTest, AKeyframeKeepsOnlyDetectionsOfMarkersItCouldHaveSeen) {
   ASSERT_NE(landmark, nullptr);
   EXPECT_EQ(landmark->observations.size(), 1u);
   EXPECT_EQ(landmark->observations.count(KeyframeId{1}), 1u);
+  // Keyframe 1 sees the marker 70 degrees from its normal: a 60-degree limit drops it too.
+  options.max_view_angle_deg = 60.0;
+  MarkerMapper strict(known, options);
+  strict.AddKeyframe(KeyframeId{1}, cam_at(16.0, 1.5), camera, {sliver});
+  ASSERT_NE(strict.landmarks().Find(MarkerId{17}), nullptr);
+  EXPECT_TRUE(strict.landmarks().Find(MarkerId{17})->observations.empty());
 }
 
 }  // namespace

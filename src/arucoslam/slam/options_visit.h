@@ -174,6 +174,8 @@ void VisitOptions(MarkerMapperOptions& o, Visitor& visit) {
         "side of markers absent from the known map, metres (0: the first known marker's)");
   visit("map_unknown", o.map_unknown, "map markers absent from the known map");
   visit("marker_pose", o.marker_pose, "IPPE ambiguity test of a single view");
+  visit("max_view_angle_deg", o.max_view_angle_deg,
+        "a keyframe's detection of a mapped marker seen beyond this angle is a misread, degrees");
   visit("max_initial_rms_px", o.max_initial_rms_px,
         "a first view reprojecting worse than this does not initialise, RMS pixels");
   visit("min_consistent_views", o.min_consistent_views,
