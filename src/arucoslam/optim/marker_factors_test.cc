@@ -295,8 +295,7 @@ TEST(MarkerFactorsTest, PosePriorsComeFromTheFixedMarkersAlone) {
 TEST(MarkerFactorsTest, PosePriorsFromCornersWeakenWithDistanceAndStopBeyondTheLimit) {
   MarkerSceneMap scene;
   Build(scene, Sim3());
-  // Distance from a prior's camera to the nearest marker its keyframe saw, in marker sides,
-  // and how many markers it saw.
+  // Distance from a prior's camera to the nearest marker its keyframe saw, in marker sides.
   const auto nearest_sides = [&](const PoseGraphProblem::PosePrior& prior) {
     double nearest = std::numeric_limits<double>::infinity();
     for (const auto& [id, landmark] : scene.landmarks.landmarks()) {

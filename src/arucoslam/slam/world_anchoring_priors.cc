@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "arucoslam/optim/pose_graph.h"
 #include "arucoslam/slam/world_anchoring.h"
 
 namespace arucoslam {
@@ -36,26 +37,26 @@ std::optional<DriftCorrectionDecision> WorldAnchoring::DecideDriftCorrection(
     if (found == keyframe_fixes_.end() || !found->second.known_markers_only) return std::nullopt;
     own = MarkerPrior(keyframe, found->second);
   }
-  DriftCorrectionDecision decision;
-  decision.priors = KnownMarkerPriors();
-  const std::optional<Rigid3> keypoint_pose =
+  const std::optional<Rigid3> keypoint_cam_from_world =
       map.Read([&](const MapData& data) -> std::optional<Rigid3> {
         const Keyframe* found = data.FindKeyframe(keyframe);
         if (found == nullptr) return std::nullopt;
-        return found->cam_from_world.Inverse();
+        return found->cam_from_world;
       });
-  if (!keypoint_pose) return std::nullopt;
-  // The keypoint pose's error as the marker prior measures it: centre, then rotation in the
-  // camera frame (PosePriorError's order).
-  Vector6d error;
-  error << keypoint_pose->translation - own->world_from_cam.translation,
-      LogSO3(own->world_from_cam.rotation.inverse() * keypoint_pose->rotation);
-  decision.offset_m = error.head<3>().norm();
-  decision.offset_sigmas = std::sqrt(std::max(0.0, error.dot(own->information * error)));
+  if (!keypoint_cam_from_world) return std::nullopt;
+  DriftCorrectionDecision decision;
+  decision.offset_m =
+      (keypoint_cam_from_world->Inverse().translation - own->world_from_cam.translation).norm();
+  // The keypoint pose's error as the pose graph measures the marker prior.
+  PoseGraphProblem keyframe_alone;
+  keyframe_alone.nodes.push_back({Sim3(*keypoint_cam_from_world)});
+  keyframe_alone.priors.push_back({0, own->world_from_cam, own->information});
+  decision.offset_sigmas = std::sqrt(std::max(0.0, PoseGraphChiSquare(keyframe_alone)));
   if (decision.offset_m < options_.min_marker_correction_m ||
       decision.offset_sigmas < options_.marker_correction_sigmas) {
     return std::nullopt;
   }
+  decision.priors = KnownMarkerPriors();
   return decision;
 }
 
