@@ -30,6 +30,26 @@ bool CouldHaveSeen(const MarkerLandmark& landmark, const Rigid3& cam_from_world,
          v < 2.0 * camera.height;
 }
 
+// Whether the camera pose a detection of `landmark` gives by itself (the IPPE solution nearer
+// the keyframe) lies within `max_offset_ratio` times the marker's distance of the keyframe's
+// centre. True when the detection gives no pose.
+bool DetectionAgreesWithPose(const MarkerLandmark& landmark, const MarkerObservation& observation,
+                             const Rigid3& cam_from_world, const CameraModel& camera,
+                             const MarkerPoseOptions& pose_options, double max_offset_ratio) {
+  const std::optional<MarkerPose> pose =
+      EstimateMarkerPose(observation.AsDetection(), landmark.size, camera, pose_options);
+  if (!pose) return true;
+  const Eigen::Vector3d centre = cam_from_world.Inverse().translation;
+  const double max_offset =
+      max_offset_ratio * (landmark.world_from_marker.translation - centre).norm();
+  for (int s = 0; s < pose->num_solutions; ++s) {
+    const Eigen::Vector3d implied =
+        (landmark.world_from_marker * pose->solutions[s].cam_from_marker.Inverse()).translation;
+    if ((implied - centre).norm() <= max_offset) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 MarkerMapper::MarkerMapper(const MarkerMap& known, const MarkerMapperOptions& options)
@@ -54,7 +74,9 @@ std::vector<MarkerId> MarkerMapper::AddKeyframe(KeyframeId keyframe, const Rigid
   std::vector<MarkerId> initialised;
   for (const MarkerObservation& observation : markers) {
     if (const MarkerLandmark* landmark = landmarks_.Find(observation.marker_id)) {
-      if (CouldHaveSeen(*landmark, cam_from_world, camera, options_.max_view_angle_deg)) {
+      if (CouldHaveSeen(*landmark, cam_from_world, camera, options_.max_view_angle_deg) &&
+          DetectionAgreesWithPose(*landmark, observation, cam_from_world, camera,
+                                  options_.marker_pose, options_.max_detection_offset_ratio)) {
         landmarks_.AddObservation(observation.marker_id, keyframe, observation.corners_px);
       }
     } else if (unknown_size_ > 0.0) {

@@ -31,6 +31,11 @@ struct MarkerMapperOptions {
   // A keyframe's detection of a mapped marker is kept only when the keyframe's pose sees the
   // marker's printed side within this angle of its normal, degrees (a misread elsewhere).
   double max_view_angle_deg = kMaxReadableViewAngleDeg;
+  // ... and when the camera pose the detection itself gives (the nearer IPPE solution, with
+  // the marker's mapped pose) lies within this many times the marker's distance of the
+  // keyframe's centre: a misread of another marker's pattern (a near marker's id on a far
+  // one's corners) puts the camera where no drift explains.
+  double max_detection_offset_ratio = 1.0;
   // A first view whose best IPPE solution reprojects worse than this (RMS, pixels) is not
   // used to initialise (blurred or partly occluded corners).
   double max_initial_rms_px = 2.0;
@@ -73,6 +78,7 @@ struct MarkerMapperOptions {
     check.AtLeast("unknown_marker_size_m", unknown_marker_size_m, 0.0);
     check.Nested("marker_pose", marker_pose);
     check.InRange("max_view_angle_deg", max_view_angle_deg, 0.0, 90.0, Interval::kOpenClosed);
+    check.Above("max_detection_offset_ratio", max_detection_offset_ratio, 0.0);
     check.Above("max_initial_rms_px", max_initial_rms_px, 0.0);
     check.AtLeast("min_consistent_views", min_consistent_views, 2);
     check.Above("max_view_disagreement_m", max_view_disagreement_m, 0.0);

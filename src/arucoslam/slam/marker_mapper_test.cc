@@ -486,5 +486,54 @@ TEST(MarkerMapperTest, AKeyframeKeepsOnlyDetectionsOfMarkersItCouldHaveSeen) {
   EXPECT_TRUE(strict.landmarks().Find(MarkerId{17})->observations.empty());
 }
 
+TEST(MarkerMapperTest, ADetectionWhosePoseNoDriftExplainsIsAMisread) {
+  // Two known markers on a wall facing +y: 17 at x = 11.8 m, 13 at x = 7.0 m. A camera at
+  // x = 12.45 m looking along -x sees 13 ahead; a misread of 13's pattern as 17 keeps 13's
+  // corners, which put the camera about 5 m in front of 17, where no drift explains it.
+  Eigen::Matrix3d axes;  // marker x along -x, y along +z, its normal along +y
+  axes.col(0) = -Eigen::Vector3d::UnitX();
+  axes.col(1) = Eigen::Vector3d::UnitZ();
+  axes.col(2) = Eigen::Vector3d::UnitY();
+  MarkerMap known;
+  for (const auto& [id, x] : {std::pair{17, 11.8}, std::pair{13, 7.0}}) {
+    MarkerInfo info;
+    info.id = id;
+    info.size = 0.2;
+    info.world_from_marker = Rigid3(Eigen::Quaterniond(axes), Eigen::Vector3d(x, 0.0, 0.6));
+    known.markers[id] = info;
+  }
+  const CameraModel camera = PinholeCamera(640, 480, 460.0);
+  Eigen::Matrix3d look_west;  // camera x = world +y, y = -world z, z = -world x
+  look_west.col(0) = Eigen::Vector3d::UnitY();
+  look_west.col(1) = -Eigen::Vector3d::UnitZ();
+  look_west.col(2) = -Eigen::Vector3d::UnitX();
+  const Rigid3 true_cam_from_world =
+      Rigid3(Eigen::Quaterniond(look_west), Eigen::Vector3d(12.45, 1.52, 0.6)).Inverse();
+  MarkerObservation seen_13;
+  seen_13.marker_id = MarkerId{13};
+  const std::array<Eigen::Vector3d, 4> corners = SquareCorners(0.2);
+  for (int i = 0; i < 4; ++i) {
+    const std::optional<Eigen::Vector2d> pixel =
+        camera.Project(true_cam_from_world * (known.markers.at(13).world_from_marker * corners[i]));
+    ASSERT_TRUE(pixel.has_value());
+    seen_13.corners_px[i] = *pixel;
+  }
+  MarkerObservation misread = seen_13;
+  misread.marker_id = MarkerId{17};
+  // The keyframe's pose has drifted 22 cm: the true detection still agrees with it.
+  const Rigid3 drifted =
+      Rigid3(Eigen::Quaterniond(look_west), Eigen::Vector3d(12.65, 1.62, 0.6)).Inverse();
+  MarkerMapperOptions options;
+  options.map_unknown = false;
+  MarkerMapper mapper(known, options);
+  mapper.AddKeyframe(KeyframeId{1}, drifted, camera, {seen_13, misread});
+  EXPECT_EQ(mapper.landmarks().Find(MarkerId{13})->observations.count(KeyframeId{1}), 1u);
+  EXPECT_TRUE(mapper.landmarks().Find(MarkerId{17})->observations.empty());
+  // Without the test (any offset allowed) the misread joins marker 17's observations.
+  options.max_detection_offset_ratio = 1e6;
+  MarkerMapper lenient(known, options);
+  lenient.AddKeyframe(KeyframeId{1}, drifted, camera, {seen_13, misread});
+  EXPECT_EQ(lenient.landmarks().Find(MarkerId{17})->observations.count(KeyframeId{1}), 1u);
+}
 }  // namespace
 }  // namespace arucoslam

@@ -176,6 +176,9 @@ void VisitOptions(MarkerMapperOptions& o, Visitor& visit) {
   visit("marker_pose", o.marker_pose, "IPPE ambiguity test of a single view");
   visit("max_view_angle_deg", o.max_view_angle_deg,
         "a keyframe's detection of a mapped marker seen beyond this angle is a misread, degrees");
+  visit("max_detection_offset_ratio", o.max_detection_offset_ratio,
+        "... or one whose own pose puts the camera farther from the keyframe than this times "
+        "the marker's distance");
   visit("max_initial_rms_px", o.max_initial_rms_px,
         "a first view reprojecting worse than this does not initialise, RMS pixels");
   visit("min_consistent_views", o.min_consistent_views,
