@@ -70,15 +70,23 @@ std::vector<MarkerId> MarkerMapper::AddKeyframe(KeyframeId keyframe, const Rigid
   const auto found = live_.find(keyframe);
   const int record = found != live_.end() ? found->second : next_record_++;
   live_[keyframe] = record;
-  records_[record] = {keyframe, generation_, cam_from_world, camera, markers};
-  std::vector<MarkerId> initialised;
+  // The record keeps the detections of unmapped markers and those of landmarks the pose
+  // could have made (a misread joins no adjustment, not even once the keyframe is retired).
+  std::vector<MarkerObservation> kept;
   for (const MarkerObservation& observation : markers) {
-    if (const MarkerLandmark* landmark = landmarks_.Find(observation.marker_id)) {
-      if (CouldHaveSeen(*landmark, cam_from_world, camera, options_.max_view_angle_deg) &&
-          DetectionAgreesWithPose(*landmark, observation, cam_from_world, camera,
-                                  options_.marker_pose, options_.max_detection_offset_ratio)) {
-        landmarks_.AddObservation(observation.marker_id, keyframe, observation.corners_px);
-      }
+    const MarkerLandmark* landmark = landmarks_.Find(observation.marker_id);
+    if (landmark == nullptr ||
+        (CouldHaveSeen(*landmark, cam_from_world, camera, options_.max_view_angle_deg) &&
+         DetectionAgreesWithPose(*landmark, observation, cam_from_world, camera,
+                                 options_.marker_pose, options_.max_detection_offset_ratio))) {
+      kept.push_back(observation);
+    }
+  }
+  records_[record] = {keyframe, generation_, cam_from_world, camera, std::move(kept)};
+  std::vector<MarkerId> initialised;
+  for (const MarkerObservation& observation : records_.at(record).markers) {
+    if (landmarks_.Find(observation.marker_id) != nullptr) {
+      landmarks_.AddObservation(observation.marker_id, keyframe, observation.corners_px);
     } else if (unknown_size_ > 0.0) {
       Observe(record, observation, &initialised);
     }

@@ -529,11 +529,16 @@ TEST(MarkerMapperTest, ADetectionWhosePoseNoDriftExplainsIsAMisread) {
   mapper.AddKeyframe(KeyframeId{1}, drifted, camera, {seen_13, misread});
   EXPECT_EQ(mapper.landmarks().Find(MarkerId{13})->observations.count(KeyframeId{1}), 1u);
   EXPECT_TRUE(mapper.landmarks().Find(MarkerId{17})->observations.empty());
+  // Retired with its map, the keyframe's record keeps its true view only.
+  mapper.CloseMap();
+  EXPECT_EQ(mapper.NumRetiredViews(), 1);
   // Without the test (any offset allowed) the misread joins marker 17's observations.
   options.max_detection_offset_ratio = 1e6;
   MarkerMapper lenient(known, options);
   lenient.AddKeyframe(KeyframeId{1}, drifted, camera, {seen_13, misread});
   EXPECT_EQ(lenient.landmarks().Find(MarkerId{17})->observations.count(KeyframeId{1}), 1u);
+  lenient.CloseMap();
+  EXPECT_EQ(lenient.NumRetiredViews(), 2);
 }
 }  // namespace
 }  // namespace arucoslam
