@@ -109,8 +109,9 @@ class MarkerMapper {
 
   // Records the markers a keyframe saw (corners in distorted pixels of `camera`) at its
   // current pose estimate in the world; a detection of a landmark that pose cannot have seen
-  // (behind the camera, seen from behind or edge-on, or far outside the image) is a misread
-  // and is left out. Returns the ids of markers initialised by this view.
+  // (behind the camera, seen from behind or edge-on, or far outside the image), or whose own
+  // pose puts the camera too far from it (max_detection_offset_ratio), is a misread and is
+  // left out, of the record too. Returns the ids of markers initialised by this view.
   std::vector<MarkerId> AddKeyframe(KeyframeId keyframe, const Rigid3& cam_from_world,
                                     const CameraModel& camera,
                                     const std::vector<MarkerObservation>& markers);
