@@ -15,6 +15,7 @@ tests=(
   "src/arucoslam/pipeline/test_pipeline_system_recovery_test|*Threaded*"
   "src/arucoslam/pipeline/test_pipeline_marker_detector_worker_test|*"
   "src/arucoslam/pipeline/test_pipeline_marker_frontend_test|*"
+  "src/arucoslam/pipeline/test_pipeline_mapping_gate_test|*"
   "src/arucoslam/slam/test_slam_online_marker_mapping_test|*"
   "src/arucoslam/util/test_util_thread_pool_test|*"
   "src/arucoslam/feature/test_feature_orb_extractor_test|*ThreadCount*"

@@ -51,7 +51,9 @@ void System::StartMappingThread() {
   }
   mapping_thread_ = std::thread([this] {
     while (const std::optional<KeyframeId> keyframe = queue_->Pop()) {
+      gate_.Enter();
       MapKeyframe(*keyframe);
+      gate_.Leave();
       mapping_busy_ = false;
       {
         std::lock_guard lock(mapped_mutex_);
@@ -71,6 +73,14 @@ void System::StopMappingThread() {
 void System::Resume() {
   mapping_busy_ = false;
   StartMappingThread();
+}
+
+void System::Hold() {
+  if (!options_.blocking) gate_.Hold();
+}
+
+void System::Release() {
+  if (!options_.blocking) gate_.Release();
 }
 
 bool System::Idle() const {

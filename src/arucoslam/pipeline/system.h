@@ -4,12 +4,11 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <opencv2/core.hpp>
-
 #include <atomic>
 #include <condition_variable>
 #include <memory>
 #include <mutex>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <thread>
 #include <vector>
@@ -17,6 +16,7 @@
 #include "arucoslam/feature/orb_extractor.h"
 #include "arucoslam/map/map.h"
 #include "arucoslam/pipeline/bounded_queue.h"
+#include "arucoslam/pipeline/mapping_gate.h"
 #include "arucoslam/pipeline/marker_frontend.h"
 #include "arucoslam/pipeline/system_options.h"
 #include "arucoslam/pipeline/system_report.h"
@@ -84,6 +84,8 @@ class System : private MappingControl {
   void WaitUntilMapped() override;
   void Pause() override { StopMappingThread(); }
   void Resume() override;
+  void Hold() override;
+  void Release() override;
   bool KeyframeWaiting() const override { return queue_ && queue_->Size() > 0; }
 
   CameraModel camera_;
@@ -98,6 +100,7 @@ class System : private MappingControl {
 
   std::unique_ptr<BoundedQueue<KeyframeId>> queue_;
   std::thread mapping_thread_;
+  MappingGate gate_;  // Hold / Release between two keyframes
   std::atomic<bool> mapping_busy_{false};
   // Threaded mode: keyframes pushed to queue_ and keyframes the mapping thread finished,
   // both counted from StartMappingThread (synchronous_young_map_keyframes).

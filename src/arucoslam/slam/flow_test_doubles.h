@@ -14,7 +14,7 @@
 namespace arucoslam::test_doubles {
 
 // Keyframes mapped between frames, as the blocking pipeline does (the caller maps `pending`);
-// counts the pauses.
+// counts the pauses and holds.
 class InlineMapping final : public MappingControl {
  public:
   bool Idle() const override { return true; }
@@ -26,11 +26,15 @@ class InlineMapping final : public MappingControl {
   void WaitUntilMapped() override {}
   void Pause() override { ++num_pauses; }
   void Resume() override { ++num_resumes; }
+  void Hold() override { ++num_holds; }
+  void Release() override { ++num_releases; }
   bool KeyframeWaiting() const override { return false; }
 
   std::vector<KeyframeId> pending;
   int num_pauses = 0;
   int num_resumes = 0;
+  int num_holds = 0;
+  int num_releases = 0;
 };
 
 // A place database that offers the pose it is given (none: nothing found) and counts what

@@ -155,8 +155,9 @@ TEST(FrameFlow, KeypointsAloneInitialiseTrackAndMapTheSceneUpToScale) {
   EXPECT_EQ(harness.stats().num_losses, 0);
   EXPECT_GE(harness.stats().num_keyframes_inserted, 3);
   EXPECT_FALSE(harness.flow().world_aligned());
-  // Nothing moved the map as a whole: mapping was never paused.
+  // Nothing moved the map as a whole: mapping was never paused or held.
   EXPECT_EQ(harness.mapping().num_pauses, 0);
+  EXPECT_EQ(harness.mapping().num_holds, 0);
   const std::vector<StampedPose> trajectory = harness.flow().CheckedTrajectory(nullptr);
   EXPECT_GE(static_cast<int>(trajectory.size()), 0.95 * (num_frames - first_initialised));
   // The camera travels about 2.4 m; the bound is 1% of that.
@@ -176,9 +177,9 @@ TEST(FrameFlow, KnownMarkersPutTheMapInTheWorldAtMetricScale) {
   EXPECT_FALSE(reports.back().marker_pose);
   EXPECT_TRUE(reports.back().world_aligned);
   ASSERT_TRUE(reports.back().online_world_from_cam);
-  // Each alignment paused mapping while it moved the map, and resumed it.
-  EXPECT_GE(harness.mapping().num_pauses, 1);
-  EXPECT_EQ(harness.mapping().num_pauses, harness.mapping().num_resumes);
+  // Each alignment held mapping while it moved the map, and released it.
+  EXPECT_GE(harness.mapping().num_holds, 1);
+  EXPECT_EQ(harness.mapping().num_holds, harness.mapping().num_releases);
   const std::vector<StampedPose> trajectory = harness.flow().CheckedTrajectory(nullptr);
   EXPECT_EQ(trajectory.size(), 80u);
   // In the world frame as it is, without alignment: a centimetre.

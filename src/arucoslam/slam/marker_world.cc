@@ -37,7 +37,7 @@ void MarkerWorld::MaybeAlign(const MarkerWorldParts& parts, Frame& frame) {
   const std::vector<WorldAnchor>& anchors = decision->anchors;
   const WorldAlignment& alignment = decision->alignment;
   const Sim3& world_from_map = alignment.world_from_map;
-  parts.mapping.Pause();  // every queued keyframe is mapped first; mapping is idle below
+  parts.mapping.Hold();  // no keyframe is being mapped below; the queued ones move with the map
   const MapSession& session = parts.lifecycle.session();
   const std::set<KeyframeId>& absorbed = session.absorbed_keyframes();
   if (anchoring.aligned() && !absorbed.empty() && session.LinkedToAbsorbedMap(parts.map)) {
@@ -45,7 +45,7 @@ void MarkerWorld::MaybeAlign(const MarkerWorldParts& parts, Frame& frame) {
     // re-alignment from this map's anchors alone would tear them apart. Markers correct the
     // map by fusion from here on (drift correction, marker corners in bundle adjustment).
     anchoring.StopRealigning();
-    parts.mapping.Resume();
+    parts.mapping.Release();
     ARUCOSLAM_LOG_DEBUG("world re-alignment stopped: the merged map is linked to this one");
     return;
   }
@@ -64,7 +64,7 @@ void MarkerWorld::MaybeAlign(const MarkerWorldParts& parts, Frame& frame) {
     frame.cam_from_world = world_from_map.TransformPose(frame.cam_from_world->Inverse()).Inverse();
   }
   parts.lifecycle.MergeClosedMap(parts.ForLifecycle());
-  parts.mapping.Resume();
+  parts.mapping.Release();
   ARUCOSLAM_LOG_DEBUG(
       "keypoint map {}aligned to the marker world: scale {:.4f}, {} of {} "
       "anchors, rms {:.3f} m",

@@ -104,14 +104,15 @@ TEST(MarkerWorld, TheMapIsAlignedOnceEnoughAnchorsAgreeAndTheFrameFollows) {
   for (int i = 0; i < 3; ++i) harness.anchoring().AddAnchor(ids[i], FixAt(truth[i]));
   harness.world().MaybeAlign(harness.Parts(), frame);
   EXPECT_FALSE(harness.anchoring().aligned());
-  EXPECT_EQ(harness.mapping().num_pauses, 0);
+  EXPECT_EQ(harness.mapping().num_holds, 0);
 
   for (int i = 3; i < 5; ++i) harness.anchoring().AddAnchor(ids[i], FixAt(truth[i]));
   harness.world().MaybeAlign(harness.Parts(), frame);
   EXPECT_TRUE(harness.anchoring().aligned());
-  // Mapping paused while the map moved, and resumed.
-  EXPECT_EQ(harness.mapping().num_pauses, 1);
-  EXPECT_EQ(harness.mapping().num_resumes, 1);
+  // Mapping held (not drained) while the map moved, and released.
+  EXPECT_EQ(harness.mapping().num_holds, 1);
+  EXPECT_EQ(harness.mapping().num_releases, 1);
+  EXPECT_EQ(harness.mapping().num_pauses, 0);
   for (std::size_t i = 0; i < ids.size(); ++i) {
     EXPECT_LT((CentreOf(harness.map(), ids[i]) - truth[i].Inverse().translation).norm(), 1e-6) << i;
   }

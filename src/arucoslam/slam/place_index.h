@@ -67,9 +67,14 @@ class MappingControl {
   virtual bool Submit(KeyframeId keyframe) = 0;
   // Waits until every keyframe queued so far is mapped.
   virtual void WaitUntilMapped() = 0;
-  // Every queued keyframe mapped and mapping stopped, until Resume (the map is moved meanwhile).
+  // Every queued keyframe mapped and mapping stopped, until Resume (the map is replaced
+  // meanwhile).
   virtual void Pause() = 0;
   virtual void Resume() = 0;
+  // The keyframe being mapped finished and no other started, until Release: the queued ones
+  // wait (the map is moved meanwhile, queued keyframes with it).
+  virtual void Hold() = 0;
+  virtual void Release() = 0;
   // A keyframe waits in the queue (a running local BA may yield to it).
   virtual bool KeyframeWaiting() const = 0;
 };
