@@ -30,6 +30,12 @@ class MappingGate {
     held_ = true;
     changed_.wait(lock, [&] { return !inside_; });
   }
+  // Whether a hold waits or is in force: the keyframe in progress should finish soon (a local
+  // BA yields to it as to a queued keyframe).
+  bool HoldRequested() const {
+    std::lock_guard lock(mutex_);
+    return held_;
+  }
   void Release() {
     {
       std::lock_guard lock(mutex_);
@@ -39,7 +45,7 @@ class MappingGate {
   }
 
  private:
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
   std::condition_variable changed_;
   bool held_ = false;    // no keyframe may enter
   bool inside_ = false;  // a keyframe is being mapped

@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <future>
+#include <thread>
 
 namespace arucoslam {
 namespace {
@@ -13,8 +14,11 @@ using std::chrono::milliseconds;
 TEST(MappingGate, HoldWaitsForTheKeyframeInProgressThenKeepsTheNextOneOut) {
   MappingGate gate;
   gate.Enter();  // a keyframe is being mapped
+  EXPECT_FALSE(gate.HoldRequested());
   std::future<void> hold = std::async(std::launch::async, [&] { gate.Hold(); });
-  // The hold cannot return while the keyframe is in progress.
+  // The mapping thread sees the hold asked for (a local BA yields to it) ...
+  while (!gate.HoldRequested()) std::this_thread::yield();
+  // ... and the hold cannot return while the keyframe is in progress.
   EXPECT_EQ(hold.wait_for(milliseconds(100)), std::future_status::timeout);
   gate.Leave();
   hold.get();
@@ -23,6 +27,7 @@ TEST(MappingGate, HoldWaitsForTheKeyframeInProgressThenKeepsTheNextOneOut) {
   EXPECT_EQ(next.wait_for(milliseconds(100)), std::future_status::timeout);
   gate.Release();
   next.get();
+  EXPECT_FALSE(gate.HoldRequested());
   gate.Leave();
 }
 

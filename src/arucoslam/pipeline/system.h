@@ -86,7 +86,9 @@ class System : private MappingControl {
   void Resume() override;
   void Hold() override;
   void Release() override;
-  bool KeyframeWaiting() const override { return queue_ && queue_->Size() > 0; }
+  bool KeyframeWaiting() const override {
+    return queue_ && (queue_->Size() > 0 || gate_.HoldRequested());
+  }
 
   CameraModel camera_;
   SystemOptions options_;
