@@ -4,11 +4,12 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <opencv2/core.hpp>
+
 #include <atomic>
 #include <condition_variable>
 #include <memory>
 #include <mutex>
-#include <opencv2/core.hpp>
 #include <optional>
 #include <thread>
 #include <vector>
@@ -86,7 +87,7 @@ class System : private MappingControl {
   void Resume() override;
   void Hold() override;
   void Release() override;
-  bool KeyframeWaiting() const override {
+  bool YieldRequested() const override {
     return queue_ && (queue_->Size() > 0 || gate_.HoldRequested());
   }
 

@@ -28,7 +28,7 @@ class InlineMapping final : public MappingControl {
   void Resume() override { ++num_resumes; }
   void Hold() override { ++num_holds; }
   void Release() override { ++num_releases; }
-  bool KeyframeWaiting() const override { return false; }
+  bool YieldRequested() const override { return false; }
 
   std::vector<KeyframeId> pending;
   int num_pauses = 0;

@@ -24,7 +24,7 @@ void FrameFlow::MakeLocalMapper() {
         [this](const Keyframe& keyframe) { return anchoring_.KeepsKeyframe(keyframe); });
   }
   if (!options_.inline_mapping && options_.yield_bundle_adjustment) {
-    mapper_->SetYieldRequest([this] { return mapping_->KeyframeWaiting(); });
+    mapper_->SetYieldRequest([this] { return mapping_->YieldRequested(); });
   }
 }
 

@@ -75,8 +75,8 @@ class MappingControl {
   // wait (the map is moved meanwhile, queued keyframes with it).
   virtual void Hold() = 0;
   virtual void Release() = 0;
-  // A keyframe waits in the queue, or a hold waits (a running local BA may yield to it).
-  virtual bool KeyframeWaiting() const = 0;
+  // A running local BA should yield: a keyframe waits in the queue, or a hold waits.
+  virtual bool YieldRequested() const = 0;
 };
 
 }  // namespace arucoslam
