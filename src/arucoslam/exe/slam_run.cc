@@ -122,7 +122,10 @@ SlamRunResult RunSlamOnSource(FrameSource& source, const std::string& dataset_la
                               const RunControl& control) {
   StagedDirectory staged(out_dir);
   const Stopwatch wall;
-  System system(source.camera(), options);
+  SystemOptions run_options = options;
+  // A camera's frames are dropped while tracking waits.
+  run_options.live_source = options.live_source || source.live();
+  System system(source.camera(), run_options);
   if (reuse.loaded) {
     system.StartFromMap(std::move(*reuse.loaded), reuse.loaded_info.world_aligned,
                         reuse.localize_only);

@@ -46,6 +46,9 @@ void VisitOptions(SystemOptions& o, Visitor& visit) {
         "threaded: a local BA ends early once another keyframe waits");
   visit("synchronous_young_map_keyframes", o.synchronous_young_map_keyframes,
         "threaded: tracking waits for mapping while the map has at most this many keyframes");
+  visit("live_source", o.live_source,
+        "threaded, frames at a camera's pace (always for --device and --realtime): tracking never "
+        "waits for the young map, which takes keyframes only from an idle mapper");
   visit("synchronous_until_aligned", o.synchronous_until_aligned,
         "threaded, marker map: ... and while the map is not aligned to the marker world");
   visit("max_initialization_gap_s", o.max_initialization_gap_s,

@@ -85,6 +85,9 @@ void System::Release() {
 
 bool System::Idle() const {
   if (options_.blocking) return true;
+  // mapping_busy_ is cleared after each keyframe, so a keyframe taken from the queue as the
+  // one before it finished reads as idle while it is mapped. Counting it as busy gave fewer
+  // keyframes and less accurate threaded runs (BENCHMARKS.md, "Threaded runs").
   return !mapping_busy_ && queue_->Size() == 0;
 }
 

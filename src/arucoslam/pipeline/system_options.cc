@@ -47,6 +47,7 @@ FrameFlowOptions SystemOptions::FlowOptions() const {
   flow.marker_mapping.min_locating_keyframes = min_locating_marker_keyframes;
   flow.min_frames_between_anchor_keyframes = min_frames_between_anchor_keyframes;
   flow.synchronous_young_map_keyframes = synchronous_young_map_keyframes;
+  flow.live_source = live_source;
   flow.synchronous_until_aligned = synchronous_until_aligned;
   flow.inline_mapping = blocking;
   flow.yield_bundle_adjustment = yield_bundle_adjustment;

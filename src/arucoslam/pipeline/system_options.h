@@ -50,8 +50,14 @@ struct SystemOptions {
   bool yield_bundle_adjustment = true;
   // Threaded mode: while the map holds at most this many keyframes, tracking waits until
   // each new keyframe is mapped before it takes the next frame, as in blocking mode: a young
-  // map tracked ahead of its local BA drifts in scale. 0: tracking never waits.
+  // map tracked ahead of its local BA drifts in scale. 0: tracking never waits. A live
+  // source never waits (live_source).
   int synchronous_young_map_keyframes = 20;
+  // Threaded mode, frames at a camera's pace (`run` sets it for a live camera and for
+  // --realtime): tracking never waits for the young map, whose frames the camera would drop;
+  // while it holds at most synchronous_young_map_keyframes keyframes, a keyframe goes in only
+  // when the mapper is idle instead, so that each is still mapped before the next.
+  bool live_source = false;
   // With a marker map: tracking also waits for every keyframe of a map not yet aligned to the
   // marker world. Off by default: a live camera would lose the frames of every such wait.
   bool synchronous_until_aligned = false;

@@ -14,10 +14,10 @@
 namespace arucoslam::test_doubles {
 
 // Keyframes mapped between frames, as the blocking pipeline does (the caller maps `pending`);
-// counts the pauses and holds.
+// counts the pauses and holds. `busy` plays a mapper still mapping a keyframe.
 class InlineMapping final : public MappingControl {
  public:
-  bool Idle() const override { return true; }
+  bool Idle() const override { return !busy; }
   bool HasRoom() const override { return true; }
   bool Submit(KeyframeId keyframe) override {
     pending.push_back(keyframe);
@@ -31,6 +31,7 @@ class InlineMapping final : public MappingControl {
   bool YieldRequested() const override { return false; }
 
   std::vector<KeyframeId> pending;
+  bool busy = false;
   int num_pauses = 0;
   int num_resumes = 0;
   int num_holds = 0;

@@ -35,6 +35,10 @@ struct FrameFlowOptions {
   // Threaded mapping: a keyframe is mapped before the next frame while the map has at most
   // this many keyframes, and (synchronous_until_aligned) until it is in the marker world.
   int synchronous_young_map_keyframes = 20;
+  // Frames come at a camera's pace and are dropped while tracking waits: tracking never waits
+  // for the young map's keyframes; while the map has at most synchronous_young_map_keyframes,
+  // a keyframe goes in only when the mapper is idle instead, so each is mapped before the next.
+  bool live_source = false;
   bool synchronous_until_aligned = false;
   bool inline_mapping = true;           // keyframes are mapped between frames (blocking mode)
   bool yield_bundle_adjustment = true;  // threaded: a local BA yields to a waiting keyframe

@@ -86,7 +86,7 @@ class FlowHarness {
 
   FrameFlow& flow() { return flow_; }
   const FrameFlowStats& stats() const { return stats_; }
-  const InlineMapping& mapping() const { return mapping_; }
+  InlineMapping& mapping() { return mapping_; }
 
  private:
   InlineMapping mapping_;
@@ -162,6 +162,38 @@ TEST(FrameFlow, KeypointsAloneInitialiseTrackAndMapTheSceneUpToScale) {
   EXPECT_GE(static_cast<int>(trajectory.size()), 0.95 * (num_frames - first_initialised));
   // The camera travels about 2.4 m; the bound is 1% of that.
   EXPECT_LT(RmsError(trajectory, TruthFromEstimate(trajectory)), 0.024);
+}
+
+TEST(FrameFlow, ALiveSourcesYoungMapTakesNoKeyframeWhileTheMapperIsBusy) {
+  // A busy mapper: a recorded sequence's young map still takes a keyframe after
+  // max_frames_between frames (tracking would then wait for it to be mapped); a live
+  // source's, which never waits, takes one only once the mapper is idle.
+  for (const bool live : {false, true}) {
+    SCOPED_TRACE(live ? "live" : "recorded");
+    FrameFlowOptions options = FlowHarness::Options(/*markers=*/false);
+    options.synchronous_young_map_keyframes = 1000;
+    options.live_source = live;
+    FlowHarness harness(/*markers=*/false, options);
+    int t = 0;
+    for (; t < 30; ++t) harness.Step(t);
+    ASSERT_EQ(harness.flow().state(), TrackingState::kTracking);
+    harness.mapping().busy = true;
+    int inserted_while_busy = 0;
+    for (const int end = t + 30; t < end; ++t) {
+      const FrameReport report = harness.Step(t);
+      EXPECT_EQ(report.state, TrackingState::kTracking) << t;
+      if (report.new_keyframe) ++inserted_while_busy;
+    }
+    if (live) {
+      EXPECT_EQ(inserted_while_busy, 0);
+    } else {
+      EXPECT_GE(inserted_while_busy, 1);
+    }
+    harness.mapping().busy = false;
+    bool inserted_when_idle = false;
+    for (const int end = t + 30; t < end; ++t) inserted_when_idle |= harness.Step(t).new_keyframe;
+    EXPECT_TRUE(inserted_when_idle);
+  }
 }
 
 TEST(FrameFlow, KnownMarkersPutTheMapInTheWorldAtMetricScale) {
