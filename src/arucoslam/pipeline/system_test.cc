@@ -42,11 +42,12 @@ std::shared_ptr<const Vocabulary> ShippedVocabulary() {
 
 RunResult RunSynthetic(bool blocking, int num_frames, bool moving = true,
                        std::shared_ptr<const Vocabulary> vocabulary = nullptr,
-                       int max_backfill_frames =
-                           SystemOptions().map_session.max_backfill_frames) {
+                       int max_backfill_frames = SystemOptions().map_session.max_backfill_frames,
+                       bool live_source = false) {
   SyntheticFeatureScene scene(TestCamera());
   SystemOptions options;
   options.blocking = blocking;
+  options.live_source = live_source;
   options.map_session.max_backfill_frames = max_backfill_frames;
   options.vocabulary = std::move(vocabulary);
   System system(TestCamera(), options);
@@ -245,6 +246,18 @@ TEST(System, ThreadedRunTracksSyntheticSequence) {
   const RunResult run = RunSynthetic(false, num_frames);
   ASSERT_GE(run.first_initialised, 1);
   EXPECT_GE(static_cast<int>(run.trajectory.size()), 0.95 * (num_frames - run.first_initialised));
+  EXPECT_EQ(run.invariants, "");
+  EXPECT_LT(AlignedRmsError(run.trajectory), 0.024);
+}
+
+TEST(System, ThreadedRunOfALiveSourceTracksSyntheticSequence) {
+  // A live source's young map takes keyframes only from an idle mapper; tracking never waits.
+  const int num_frames = 80;
+  const RunResult run = RunSynthetic(false, num_frames, true, nullptr,
+                                     SystemOptions().map_session.max_backfill_frames, true);
+  ASSERT_GE(run.first_initialised, 1);
+  EXPECT_GE(static_cast<int>(run.trajectory.size()), 0.95 * (num_frames - run.first_initialised));
+  EXPECT_GE(run.stats.num_keyframes_inserted, 4);
   EXPECT_EQ(run.invariants, "");
   EXPECT_LT(AlignedRmsError(run.trajectory), 0.024);
 }
