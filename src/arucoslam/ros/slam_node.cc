@@ -56,6 +56,7 @@ SlamNodeParameters ReadSlamNodeParameters(const ros::NodeHandle& private_node,
   private_node.param("features", session->num_features, session->num_features);
   private_node.param("loop_closing", session->loop_closing, session->loop_closing);
   private_node.param("blocking", session->blocking, session->blocking);
+  private_node.param("live_source", session->live_source, session->live_source);
   return params;
 }
 

@@ -51,7 +51,7 @@ struct SlamNodeParameters {
 
 // Reads the node's parameters from `private_node` ("~"); throws InputError naming the
 // parameter on a bad value. `session` receives the SLAM options (marker_map, vocabulary,
-// num_features, loop_closing, blocking).
+// num_features, loop_closing, blocking, live_source).
 SlamNodeParameters ReadSlamNodeParameters(const ros::NodeHandle& private_node,
                                           SlamSessionOptions* session);
 

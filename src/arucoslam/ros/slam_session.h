@@ -31,6 +31,10 @@ struct SlamSessionOptions {
   // false: local mapping on its own thread (the node's default); true: each frame tracked and
   // mapped before Process returns (deterministic).
   bool blocking = false;
+  // Threaded: frames come at the camera's pace and are dropped while tracking waits, so
+  // tracking never waits for the young map (SystemOptions::live_source). Off by default:
+  // fed one frame at a time, the node keeps the wait of recorded sequences.
+  bool live_source = false;
 
   bool Check(std::string* why = nullptr) const {
     OptionCheck check(why);
