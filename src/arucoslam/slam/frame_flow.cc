@@ -197,10 +197,7 @@ void FrameFlow::MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& 
   input.mapper_idle = mapping_->Idle();
   input.mapper_has_room = mapping_->HasRoom();
   // A live source's young map takes a keyframe only from an idle mapper (tracking never waits).
-  if (options_.live_source &&
-      static_cast<int>(map_->NumKeyframes()) <= options_.synchronous_young_map_keyframes) {
-    input.mapper_has_room = input.mapper_idle;
-  }
+  if (options_.live_source && MapIsYoung()) input.mapper_has_room = input.mapper_idle;
   // A frame with a usable marker location becomes a keyframe sooner until the map is first
   // aligned (anchors are kept on keyframes only).
   const bool wants_anchor =
@@ -221,8 +218,7 @@ void FrameFlow::MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& 
   // drift correction reads it.
   anchoring_.AddAnchor(keyframe, marker_fusion_.fix());
   if (mapping_->Submit(keyframe)) {
-    const bool young = !options_.live_source && static_cast<int>(map_->NumKeyframes()) <=
-                                                    options_.synchronous_young_map_keyframes;
+    const bool young = !options_.live_source && MapIsYoung();  // counting the new keyframe
     const bool unaligned =
         options_.marker_map && !anchoring_.aligned() && options_.synchronous_until_aligned;
     if (young || unaligned) mapping_->WaitUntilMapped();

@@ -75,6 +75,10 @@ class FrameFlow {
   void FinishInitialization(const InitialMap& initial, Frame& frame, FrameReport& report);
   void Track(Frame& frame, FrameReport& report);
   void MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& report);
+  // The map holds at most synchronous_young_map_keyframes keyframes.
+  bool MapIsYoung() const {
+    return static_cast<int>(map_->NumKeyframes()) <= options_.synchronous_young_map_keyframes;
+  }
   // A frame's tracked pose against its reference keyframe, added to pose_history_.
   void RecordPose(const Frame& frame, KeyframeId reference);
   void CountStat(int FrameFlowStats::*counter, int amount = 1);
