@@ -17,9 +17,10 @@ SlamSession::SlamSession(const SlamSessionOptions& options) {
   const std::filesystem::path vocabulary =
       options.vocabulary.empty() ? DefaultVocabularyPath() : options.vocabulary;
   // The same System options as `arucoslam run`, so that both give the same poses.
-  options_ = std::make_unique<SystemOptions>(DefaultRunOptions(
-      options.blocking, std::make_shared<const Vocabulary>(Vocabulary::Load(vocabulary)),
-      options.loop_closing));
+  options_ = std::make_unique<SystemOptions>(
+      DefaultRunOptions(options.blocking,
+                        std::make_shared<const Vocabulary>(Vocabulary::Load(vocabulary)),
+                        options.loop_closing));
   options_->extractor.num_features = options.num_features;
   options_->live_source = options.live_source;
   if (options.marker_map) {
