@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # ThreadSanitizer build of the threaded tests (the System in threaded mode, local mapping and
 # loop closing on their threads, the marker detector, its front-end and the ORB thread pools,
-# the marker mapping published across threads, the real-time replay) run clean, or fail.
+# the marker mapping published across threads, the real-time replay, the read-ahead of
+# recorded frames) run clean, or fail.
 # Usage: scripts/tsan-tests.sh [BUILD_DIR]   (default build-tsan; `make tsan` calls it)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -21,6 +22,7 @@ tests=(
   "src/arucoslam/feature/test_feature_orb_extractor_test|*ThreadCount*"
   "src/arucoslam/map/test_map_map_test|*Concurrent*"
   "src/arucoslam/io/test_io_paced_source_test|*"
+  "src/arucoslam/io/test_io_read_ahead_source_test|*"
 )
 
 # -O1 keeps the instrumented tests fast enough; no ROS, no benchmarks: only what they link.

@@ -24,6 +24,7 @@
 #include "arucoslam/io/frame_source.h"
 #include "arucoslam/io/marker_map_json.h"
 #include "arucoslam/io/paced_source.h"
+#include "arucoslam/io/read_ahead_source.h"
 #include "arucoslam/util/error.h"
 #include "arucoslam/util/files.h"
 
@@ -113,7 +114,7 @@ std::unique_ptr<FrameSource> OpenSource(const RunArgs& args) {
       dataset_options.rate_hz = args.rate_hz;
       recorded = OpenFrameSource(args.dataset, dataset_options);
     }
-    if (!args.realtime) return recorded;
+    if (!args.realtime) return std::make_unique<ReadAheadSource>(std::move(recorded));
     PacedSourceOptions paced;
     paced.stop = &g_stop_requested;
     return std::make_unique<PacedSource>(std::move(recorded), paced);

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "arucoslam/io/marker_map_json.h"
+#include "arucoslam/io/read_ahead_source.h"
 #include "arucoslam/util/error.h"
 #include "arucoslam/util/files.h"
 #include "arucoslam/util/timing.h"
@@ -188,7 +189,7 @@ SlamRunResult RunSlamOnDataset(const Dataset& dataset, const std::string& datase
                                const SystemOptions& options, bool markers,
                                const std::filesystem::path& out_dir, bool progress,
                                MapReuse reuse) {
-  DatasetSource source(dataset);
+  ReadAheadSource source(std::make_unique<DatasetSource>(dataset));
   return RunSlamOnSource(source, dataset_label, options, markers, out_dir, progress,
                          std::move(reuse));
 }

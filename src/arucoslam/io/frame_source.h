@@ -9,6 +9,7 @@
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "arucoslam/geometry/camera.h"
 #include "arucoslam/io/dataset_reader.h"
@@ -41,6 +42,26 @@ class FrameSource {
   virtual bool live() const { return false; }
   // Frames captured but never handed out (live sources only).
   virtual std::size_t frames_dropped() const { return 0; }
+};
+
+// A FrameSource that hands out the frames of a recorded one in its own way (paced, read
+// ahead); what describes the source (camera, layout, size, marker map) is the recorded one's.
+class WrappingSource : public FrameSource {
+ public:
+  explicit WrappingSource(std::unique_ptr<FrameSource> recorded) : recorded_(std::move(recorded)) {}
+  const CameraModel& camera() const override { return recorded_->camera(); }
+  std::string layout() const override { return recorded_->layout(); }
+  std::optional<std::size_t> size() const override { return recorded_->size(); }
+  std::optional<std::filesystem::path> markers_path() const override {
+    return recorded_->markers_path();
+  }
+
+ protected:
+  FrameSource& recorded() { return *recorded_; }
+  const FrameSource& recorded() const { return *recorded_; }
+
+ private:
+  std::unique_ptr<FrameSource> recorded_;
 };
 
 // A Dataset as a FrameSource (images loaded one at a time, as Next() asks).

@@ -18,7 +18,7 @@ struct PacedSource::Queue {
 };
 
 PacedSource::PacedSource(std::unique_ptr<FrameSource> recorded, const PacedSourceOptions& options)
-    : recorded_(std::move(recorded)), options_(options) {
+    : WrappingSource(std::move(recorded)), options_(options) {
   std::string why;
   if (!options.Check(&why)) throw std::invalid_argument("PacedSourceOptions: " + why);
   queue_ = std::make_unique<Queue>(options.queue_capacity);
@@ -43,7 +43,7 @@ void PacedSource::Replay() {
   std::optional<double> first_timestamp_s;
   try {
     while (!stopping()) {
-      std::optional<SourceFrame> frame = recorded_->Next();
+      std::optional<SourceFrame> frame = recorded().Next();
       if (!frame) break;
       if (!first_timestamp_s) first_timestamp_s = frame->timestamp_s;
       const auto due = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(

@@ -33,7 +33,7 @@ struct PacedSourceOptions {
   }
 };
 
-class PacedSource : public FrameSource {
+class PacedSource : public WrappingSource {
  public:
   // The replay starts with the first Next(): the first frame is due then, each next one when
   // its timestamp's offset from the first has elapsed (over `speed`). Throws
@@ -47,12 +47,6 @@ class PacedSource : public FrameSource {
   // Waits for the next frame handed over (the first call starts the replay); nullopt at the end of the recording (or on a stop
   // request) once the held frames are out. Rethrows what reading the recording threw.
   std::optional<SourceFrame> Next() override;
-  const CameraModel& camera() const override { return recorded_->camera(); }
-  std::string layout() const override { return recorded_->layout(); }
-  std::optional<std::size_t> size() const override { return recorded_->size(); }
-  std::optional<std::filesystem::path> markers_path() const override {
-    return recorded_->markers_path();
-  }
   bool live() const override { return true; }
   std::size_t frames_dropped() const override { return dropped_.load(); }
 
@@ -60,7 +54,6 @@ class PacedSource : public FrameSource {
   struct Queue;
   void Replay();
 
-  std::unique_ptr<FrameSource> recorded_;
   PacedSourceOptions options_;
   std::unique_ptr<Queue> queue_;
   std::atomic<bool> stop_requested_{false};
