@@ -9,6 +9,7 @@
 
 #include "arucoslam/exe/command.h"
 #include "arucoslam/io/calibration.h"
+#include "arucoslam/io/image_file.h"
 #include "arucoslam/io/marker_map_json.h"
 #include "arucoslam/markers/camera_locator.h"
 #include "arucoslam/markers/detector.h"
@@ -104,8 +105,7 @@ int RunLocate(const LocateArgs& args) {
   if (!std::filesystem::is_regular_file(args.image)) {
     throw InputError(args.image, "image file not found");
   }
-  const cv::Mat image = cv::imread(args.image, cv::IMREAD_UNCHANGED);
-  if (image.empty()) throw InputError(args.image, "not a readable image");
+  const cv::Mat image = ReadImageFile(args.image, cv::IMREAD_UNCHANGED);
   if (image.cols != camera.width || image.rows != camera.height) {
     throw InputError(args.image, "image is " + std::to_string(image.cols) + "x" +
                                      std::to_string(image.rows) + " but the calibration " +

@@ -13,6 +13,7 @@
 #include "arucoslam/exe/command.h"
 #include "arucoslam/feature/orb_extractor.h"
 #include "arucoslam/feature/vocabulary.h"
+#include "arucoslam/io/image_file.h"
 #include "arucoslam/util/error.h"
 #include "arucoslam/util/files.h"
 
@@ -110,8 +111,7 @@ void RunVocabTrain(const VocabTrainArgs& args) {
   std::vector<cv::Mat> descriptors;
   std::size_t num_features = 0;
   for (std::size_t i = 0; i < images.size(); ++i) {
-    const cv::Mat image = cv::imread(images[i].string(), cv::IMREAD_GRAYSCALE);
-    if (image.empty()) throw InputError(images[i].string(), "cannot read the image");
+    const cv::Mat image = ReadImageFile(images[i], cv::IMREAD_GRAYSCALE);
     descriptors.push_back(extractor.Extract(image).descriptors);
     num_features += descriptors.back().rows;
     if (!args.quiet && ((i + 1) % 100 == 0 || i + 1 == images.size())) {

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "arucoslam/io/calibration.h"
+#include "arucoslam/io/image_file.h"
 #include "arucoslam/util/error.h"
 #include "arucoslam/util/files.h"
 
@@ -188,12 +189,7 @@ std::string DatasetLayoutName(DatasetLayout layout) {
 }
 
 cv::Mat LoadGreyImage(const fs::path& path, const CameraModel& camera) {
-  cv::Mat image = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
-  if (image.empty()) {
-    throw InputError(path.string(), fs::exists(path) ? "cannot read the image (not an image "
-                                                       "or corrupt)"
-                                                     : "image not found");
-  }
+  cv::Mat image = ReadImageFile(path, cv::IMREAD_GRAYSCALE);
   if (image.cols != camera.width || image.rows != camera.height) {
     throw InputError(path.string(),
                      fmt::format("image is {}x{} but the camera calibration says {}x{}", image.cols,
@@ -382,8 +378,7 @@ Dataset Dataset::OpenKitti(const fs::path& root, const DatasetOptions& options) 
   }
   // calib.txt gives no image size: the calibrated camera takes the first image's.
   if (options.camera_path.empty() && !images.empty()) {
-    const cv::Mat first = cv::imread(images.front().string(), cv::IMREAD_GRAYSCALE);
-    if (first.empty()) throw InputError(images.front().string(), "cannot read the image");
+    const cv::Mat first = ReadImageFile(images.front(), cv::IMREAD_GRAYSCALE);
     dataset.camera_.width = first.cols;
     dataset.camera_.height = first.rows;
   }

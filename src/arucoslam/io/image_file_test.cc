@@ -1,0 +1,97 @@
+#include "arucoslam/io/image_file.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <vector>
+
+#include "arucoslam/util/error.h"
+
+namespace arucoslam {
+namespace {
+
+namespace fs = std::filesystem;
+
+class ImageFileTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    folder_ = fs::temp_directory_path() /
+              ("arucoslam_image_file_test_" +
+               std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(folder_);
+    fs::create_directories(folder_);
+    image_ = cv::Mat(48, 64, CV_8UC1);
+    cv::randu(image_, 0, 255);  // incompressible: the IDAT chunk is most of the file
+    ASSERT_TRUE(cv::imwrite((folder_ / "frame.png").string(), image_));
+    std::ifstream file(folder_ / "frame.png", std::ios::binary);
+    png_.assign(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
+  }
+  void TearDown() override { fs::remove_all(folder_); }
+
+  fs::path Write(const std::string& name, const std::vector<unsigned char>& bytes) {
+    const fs::path path = folder_ / name;
+    std::ofstream(path, std::ios::binary)
+        .write(reinterpret_cast<const char*>(bytes.data()),
+               static_cast<std::streamsize>(bytes.size()));
+    return path;
+  }
+  // The InputError message ReadImageFile gives for `path` ("" when it reads the image).
+  static std::string ErrorOf(const fs::path& path) {
+    try {
+      ReadImageFile(path, cv::IMREAD_GRAYSCALE);
+    } catch (const InputError& error) {
+      EXPECT_EQ(error.source(), path.string());
+      return error.message();
+    }
+    return "";
+  }
+
+  fs::path folder_;
+  cv::Mat image_;
+  std::vector<unsigned char> png_;
+};
+
+TEST_F(ImageFileTest, AWholePngReadsBackItsPixels) {
+  EXPECT_FALSE(PngLayoutDefect(png_).has_value());
+  const cv::Mat read = ReadImageFile(folder_ / "frame.png", cv::IMREAD_GRAYSCALE);
+  ASSERT_EQ(read.size(), image_.size());
+  EXPECT_EQ(cv::countNonZero(read != image_), 0);
+}
+
+TEST_F(ImageFileTest, ATruncatedPngIsNamedAsSuchWithoutTheDecodersOwnMessages) {
+  // Cut inside the IDAT chunk, inside the last chunk header, and just before IEND's end.
+  for (const std::size_t keep : {png_.size() / 2, png_.size() - 8, std::size_t{20}}) {
+    const std::vector<unsigned char> cut(png_.begin(), png_.begin() + static_cast<long>(keep));
+    const fs::path path = Write("cut.png", cut);
+    ::testing::internal::CaptureStderr();
+    const std::string message = ErrorOf(path);
+    const std::string printed = ::testing::internal::GetCapturedStderr();
+    EXPECT_NE(message.find("truncated PNG"), std::string::npos) << keep << ": " << message;
+    EXPECT_EQ(printed, "") << keep;
+  }
+  // Everything up to IEND but IEND itself.
+  const std::vector<unsigned char> no_end(png_.begin(), png_.end() - 12);
+  EXPECT_EQ(ErrorOf(Write("no_end.png", no_end)), "truncated PNG (no IEND chunk)");
+}
+
+TEST_F(ImageFileTest, MissingFilesAndFilesThatAreNoImageAreNamed) {
+  EXPECT_EQ(ErrorOf(folder_ / "absent.png"), "image not found");
+  const std::string text = "not an image\n";
+  EXPECT_EQ(ErrorOf(Write("notes.png", {text.begin(), text.end()})),
+            "cannot read the image (not an image or corrupt)");
+  EXPECT_EQ(ErrorOf(Write("empty.png", {})), "cannot read the image (not an image or corrupt)");
+  EXPECT_FALSE(PngLayoutDefect({text.begin(), text.end()}).has_value());  // not a PNG at all
+}
+
+TEST_F(ImageFileTest, OtherFormatsAreLeftToTheDecoder) {
+  ASSERT_TRUE(cv::imwrite((folder_ / "frame.bmp").string(), image_));
+  const cv::Mat read = ReadImageFile(folder_ / "frame.bmp", cv::IMREAD_GRAYSCALE);
+  EXPECT_EQ(cv::countNonZero(read != image_), 0);
+}
+
+}  // namespace
+}  // namespace arucoslam
