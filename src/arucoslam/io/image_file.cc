@@ -39,6 +39,19 @@ std::optional<std::string> PngLayoutDefect(const std::vector<unsigned char>& byt
   return "truncated PNG (no IEND chunk)";
 }
 
+std::optional<std::string> JpegLayoutDefect(const std::vector<unsigned char>& bytes) {
+  if (bytes.size() < 3 || bytes[0] != 0xFF || bytes[1] != 0xD8 || bytes[2] != 0xFF) {
+    return std::nullopt;  // not a JPEG
+  }
+  // Entropy-coded data stuffs every 0xFF (FF 00) or makes it a restart marker (FF D0-D7), so
+  // FF D9 near the end is the end-of-image marker; some writers pad a few bytes after it.
+  const std::size_t from = bytes.size() > 1024 ? bytes.size() - 1024 : 2;
+  for (std::size_t i = bytes.size() - 1; i > from; --i) {
+    if (bytes[i] == 0xD9 && bytes[i - 1] == 0xFF) return std::nullopt;
+  }
+  return "truncated JPEG (no end-of-image marker)";
+}
+
 cv::Mat ReadImageFile(const std::filesystem::path& path, int cv_imread_flags) {
   std::ifstream file(path, std::ios::binary);
   if (!file) {
@@ -47,8 +60,8 @@ cv::Mat ReadImageFile(const std::filesystem::path& path, int cv_imread_flags) {
   }
   const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(file)),
                                          std::istreambuf_iterator<char>());
-  if (const std::optional<std::string> defect = PngLayoutDefect(bytes)) {
-    throw InputError(path.string(), *defect);
+  for (const auto& defect : {PngLayoutDefect(bytes), JpegLayoutDefect(bytes)}) {
+    if (defect) throw InputError(path.string(), *defect);
   }
   cv::Mat image = bytes.empty() ? cv::Mat() : cv::imdecode(bytes, cv_imread_flags);
   if (image.empty())

@@ -87,6 +87,22 @@ TEST_F(ImageFileTest, MissingFilesAndFilesThatAreNoImageAreNamed) {
   EXPECT_FALSE(PngLayoutDefect({text.begin(), text.end()}).has_value());  // not a PNG at all
 }
 
+TEST_F(ImageFileTest, AJpegCutShortIsNamedAsSuchWithoutTheDecodersWarning) {
+  ASSERT_TRUE(cv::imwrite((folder_ / "frame.jpg").string(), image_));
+  std::ifstream file(folder_ / "frame.jpg", std::ios::binary);
+  const std::vector<unsigned char> jpeg((std::istreambuf_iterator<char>(file)),
+                                        std::istreambuf_iterator<char>());
+  EXPECT_FALSE(JpegLayoutDefect(jpeg).has_value());
+  EXPECT_EQ(ReadImageFile(folder_ / "frame.jpg", cv::IMREAD_GRAYSCALE).size(), image_.size());
+  const std::vector<unsigned char> cut(jpeg.begin(),
+                                       jpeg.begin() + static_cast<long>(jpeg.size() / 2));
+  const fs::path path = Write("cut.jpg", cut);
+  ::testing::internal::CaptureStderr();
+  const std::string message = ErrorOf(path);
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+  EXPECT_EQ(message, "truncated JPEG (no end-of-image marker)");
+}
+
 TEST_F(ImageFileTest, OtherFormatsAreLeftToTheDecoder) {
   ASSERT_TRUE(cv::imwrite((folder_ / "frame.bmp").string(), image_));
   const cv::Mat read = ReadImageFile(folder_ / "frame.bmp", cv::IMREAD_GRAYSCALE);
