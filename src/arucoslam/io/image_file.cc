@@ -1,5 +1,6 @@
 #include "arucoslam/io/image_file.h"
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <fstream>

@@ -2,7 +2,6 @@
 // thread, so that decoding the next images overlaps the SLAM's work on the current one.
 #pragma once
 
-#include <atomic>
 #include <cstddef>
 #include <exception>
 #include <memory>
