@@ -3,13 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
-#include <vector>
 
 #include "arucoslam/util/error.h"
+#include "arucoslam/util/files.h"
 
 namespace arucoslam {
 namespace {
@@ -27,16 +25,13 @@ class ImageFileTest : public ::testing::Test {
     image_ = cv::Mat(48, 64, CV_8UC1);
     cv::randu(image_, 0, 255);  // incompressible: the IDAT chunk is most of the file
     ASSERT_TRUE(cv::imwrite((folder_ / "frame.png").string(), image_));
-    std::ifstream file(folder_ / "frame.png", std::ios::binary);
-    png_.assign(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
+    png_ = ReadTextFile(folder_ / "frame.png");
   }
   void TearDown() override { fs::remove_all(folder_); }
 
-  fs::path Write(const std::string& name, const std::vector<unsigned char>& bytes) {
+  fs::path Write(const std::string& name, const std::string& bytes) {
     const fs::path path = folder_ / name;
-    std::ofstream(path, std::ios::binary)
-        .write(reinterpret_cast<const char*>(bytes.data()),
-               static_cast<std::streamsize>(bytes.size()));
+    WriteTextFileAtomically(path, bytes);
     return path;
   }
   // The InputError message ReadImageFile gives for `path` ("" when it reads the image).
@@ -52,7 +47,7 @@ class ImageFileTest : public ::testing::Test {
 
   fs::path folder_;
   cv::Mat image_;
-  std::vector<unsigned char> png_;
+  std::string png_;
 };
 
 TEST_F(ImageFileTest, AWholePngReadsBackItsPixels) {
@@ -65,7 +60,7 @@ TEST_F(ImageFileTest, AWholePngReadsBackItsPixels) {
 TEST_F(ImageFileTest, ATruncatedPngIsNamedAsSuchWithoutTheDecodersOwnMessages) {
   // Cut inside the IDAT chunk, inside the last chunk header, and just before IEND's end.
   for (const std::size_t keep : {png_.size() / 2, png_.size() - 8, std::size_t{20}}) {
-    const std::vector<unsigned char> cut(png_.begin(), png_.begin() + static_cast<long>(keep));
+    const std::string cut = png_.substr(0, keep);
     const fs::path path = Write("cut.png", cut);
     ::testing::internal::CaptureStderr();
     const std::string message = ErrorOf(path);
@@ -74,28 +69,24 @@ TEST_F(ImageFileTest, ATruncatedPngIsNamedAsSuchWithoutTheDecodersOwnMessages) {
     EXPECT_EQ(printed, "") << keep;
   }
   // Everything up to IEND but IEND itself.
-  const std::vector<unsigned char> no_end(png_.begin(), png_.end() - 12);
+  const std::string no_end = png_.substr(0, png_.size() - 12);
   EXPECT_EQ(ErrorOf(Write("no_end.png", no_end)), "truncated PNG (no IEND chunk)");
 }
 
 TEST_F(ImageFileTest, MissingFilesAndFilesThatAreNoImageAreNamed) {
   EXPECT_EQ(ErrorOf(folder_ / "absent.png"), "image not found");
   const std::string text = "not an image\n";
-  EXPECT_EQ(ErrorOf(Write("notes.png", {text.begin(), text.end()})),
-            "cannot read the image (not an image or corrupt)");
+  EXPECT_EQ(ErrorOf(Write("notes.png", text)), "cannot read the image (not an image or corrupt)");
   EXPECT_EQ(ErrorOf(Write("empty.png", {})), "cannot read the image (not an image or corrupt)");
-  EXPECT_FALSE(PngLayoutDefect({text.begin(), text.end()}).has_value());  // not a PNG at all
+  EXPECT_FALSE(PngLayoutDefect(text).has_value());  // not a PNG at all
 }
 
 TEST_F(ImageFileTest, AJpegCutShortIsNamedAsSuchWithoutTheDecodersWarning) {
   ASSERT_TRUE(cv::imwrite((folder_ / "frame.jpg").string(), image_));
-  std::ifstream file(folder_ / "frame.jpg", std::ios::binary);
-  const std::vector<unsigned char> jpeg((std::istreambuf_iterator<char>(file)),
-                                        std::istreambuf_iterator<char>());
+  const std::string jpeg = ReadTextFile(folder_ / "frame.jpg");
   EXPECT_FALSE(JpegLayoutDefect(jpeg).has_value());
   EXPECT_EQ(ReadImageFile(folder_ / "frame.jpg", cv::IMREAD_GRAYSCALE).size(), image_.size());
-  const std::vector<unsigned char> cut(jpeg.begin(),
-                                       jpeg.begin() + static_cast<long>(jpeg.size() / 2));
+  const std::string cut = jpeg.substr(0, jpeg.size() / 2);
   const fs::path path = Write("cut.jpg", cut);
   ::testing::internal::CaptureStderr();
   const std::string message = ErrorOf(path);
