@@ -5,13 +5,13 @@
 #include <stdexcept>
 #include <utility>
 
-#include "arucoslam/pipeline/bounded_queue.h"
+#include "arucoslam/io/frame_handoff.h"
 
 namespace arucoslam {
 
 struct PacedSource::Queue {
   explicit Queue(std::size_t capacity) : frames(capacity) {}
-  BoundedQueue<SourceFrame> frames;
+  FrameHandoff frames;
   // Wakes the replay thread's wait for a frame's due time on a stop request.
   std::mutex wake_mutex;
   std::condition_variable wake;
@@ -59,22 +59,16 @@ void PacedSource::Replay() {
       if (!queue_->frames.TryPush(std::move(*frame))) ++dropped_;
     }
   } catch (...) {
-    std::lock_guard lock(error_mutex_);
-    error_ = std::current_exception();
+    queue_->frames.Fail(std::current_exception());
   }
   queue_->frames.Close();
 }
 
 std::optional<SourceFrame> PacedSource::Next() {
   if (!thread_.joinable()) thread_ = std::thread([this] { Replay(); });
-  std::optional<SourceFrame> frame = queue_->frames.Pop();
-  if (frame) {
-    frame->index = next_index_++;
-    return frame;
-  }
-  std::lock_guard lock(error_mutex_);
-  if (error_) std::rethrow_exception(std::exchange(error_, nullptr));
-  return std::nullopt;
+  std::optional<SourceFrame> frame = queue_->frames.Take();
+  if (frame) frame->index = next_index_++;
+  return frame;
 }
 
 }  // namespace arucoslam

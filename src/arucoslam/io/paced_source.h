@@ -58,8 +58,6 @@ class PacedSource : public WrappingSource {
   std::unique_ptr<Queue> queue_;
   std::atomic<bool> stop_requested_{false};
   std::atomic<std::size_t> dropped_{0};
-  std::mutex error_mutex_;
-  std::exception_ptr error_;  // what the recording threw, for Next()
   std::size_t next_index_ = 0;
   std::thread thread_;
 };

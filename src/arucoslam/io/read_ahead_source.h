@@ -3,9 +3,7 @@
 #pragma once
 
 #include <cstddef>
-#include <exception>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
@@ -25,6 +23,8 @@ struct ReadAheadOptions {
   }
 };
 
+class FrameHandoff;
+
 class ReadAheadSource : public WrappingSource {
  public:
   // Reading starts with the first Next(). Throws std::invalid_argument on options that fail
@@ -43,12 +43,9 @@ class ReadAheadSource : public WrappingSource {
   std::size_t frames_dropped() const override { return recorded().frames_dropped(); }
 
  private:
-  struct Queue;
   void Read();
 
-  std::unique_ptr<Queue> queue_;
-  std::mutex error_mutex_;
-  std::exception_ptr error_;  // what the recording threw, for Next()
+  std::unique_ptr<FrameHandoff> frames_;
   std::thread thread_;
 };
 
