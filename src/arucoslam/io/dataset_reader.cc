@@ -100,7 +100,7 @@ CameraCalibration RequireCamera(const DatasetOptions& options, const fs::path& r
   if (options.camera_path.empty()) {
     throw InputError(
         root.string(),
-        fmt::format("a {} sequence needs a camera calibration file (--camera)", layout));
+        fmt::format("the {} layout needs a camera calibration file (--camera)", layout));
   }
   return ReadCameraCalibration(options.camera_path);
 }

@@ -178,7 +178,8 @@ TEST_F(DatasetReaderTest, TumRgbdFolder) {
             "1305031102.211214 rgb/1.png\n");
   WriteText(seq / "groundtruth.txt",
             "# timestamp tx ty tz qx qy qz qw\n1305031102.1758 1 2 3 0 0 0 1\n");
-  ExpectInputError([&] { Dataset::Open(seq); }, "tum", "--camera");
+  ExpectInputError([&] { Dataset::Open(seq); }, "tum",
+                   "the TUM RGB-D layout needs a camera calibration file (--camera)");
   WriteEuRoCSensorYaml(SmallCamera(), folder_ / "camera.yaml");
   DatasetOptions options;
   options.camera_path = folder_ / "camera.yaml";
@@ -203,6 +204,8 @@ TEST_F(DatasetReaderTest, ImageFolderSortedWithRate) {
     cv::imwrite((seq / name).string(), cv::Mat(48, 64, CV_8U, cv::Scalar(0)));
   }
   WriteText(seq / "notes.txt", "not an image");
+  ExpectInputError([&] { Dataset::Open(seq); }, "images",
+                   "the image-folder layout needs a camera calibration file (--camera)");
   WriteEuRoCSensorYaml(SmallCamera(), folder_ / "camera.yaml");
   DatasetOptions options;
   options.camera_path = folder_ / "camera.yaml";
