@@ -63,7 +63,6 @@ SlamRunStats MakeStats(const std::string& dataset_label, const FrameSource& sour
   out.world_alignments = stats.world_anchoring.num_alignments;
   out.marker_drift_corrections = stats.world_anchoring.num_drift_corrections;
   out.marker_rejections = stats.marker_fusion.num_rejected_poses;
-  out.drift_beyond_gate = stats.marker_fusion.num_drift_disagreements;
   out.whole_map_marker_adjustments = stats.num_whole_map_marker_adjustments;
   out.map_merges = stats.map_session.num_map_merges;
   out.wall_time_s = wall_time_s;

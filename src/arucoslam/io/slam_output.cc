@@ -64,8 +64,7 @@ std::string FormatSlamStatsJson(const SlamRunStats& stats) {
                              {"drift_corrections", stats.marker_drift_corrections},
                              {"whole_map_adjustments", stats.whole_map_marker_adjustments},
                              {"map_merges", stats.map_merges},
-                             {"rejected_keypoint_poses", stats.marker_rejections},
-                             {"drift_beyond_gate", stats.drift_beyond_gate}};
+                             {"rejected_keypoint_poses", stats.marker_rejections}};
   }
   nlohmann::ordered_json timings = nlohmann::ordered_json::object();
   for (const auto& [stage, summary] : stats.timings_ms) {

@@ -56,12 +56,10 @@ struct SlamRunStats {
   int marker_only_poses = 0;
   // ... and how the map was fused with them: world alignments, pose-graph drift
   // corrections, bundle adjustments of a whole map with every marker view, closed maps
-  // merged into a later one, keypoint poses the markers rejected (a look-alike place) and
-  // disagreements beyond that gate taken as drift to correct instead.
+  // merged into a later one, and keypoint poses the markers rejected (a look-alike place).
   int world_alignments = 0;
   int marker_drift_corrections = 0;
   int marker_rejections = 0;
-  int drift_beyond_gate = 0;
   int whole_map_marker_adjustments = 0;
   int map_merges = 0;
   double wall_time_s = 0.0;
@@ -81,7 +79,7 @@ std::string FormatPlyPoints(const std::vector<Eigen::Vector3d>& points);
 // {"frames_with_fix", "disambiguated_by_motion", "disambiguated_by_map_rotation",
 // "disambiguated_by_covisible_markers", "relocated_at_end", "posed_at_end",
 // "marker_only_poses"}, "marker_fusion": {"world_alignments", "drift_corrections",
-// "whole_map_adjustments", "map_merges", "rejected_keypoint_poses", "drift_beyond_gate"},
+// "whole_map_adjustments", "map_merges", "rejected_keypoint_poses"},
 // "timings_ms": {stage: {count, mean, median, p95, max}}, "wall_time_s", "peak_memory_bytes"}.
 std::string FormatSlamStatsJson(const SlamRunStats& stats);
 

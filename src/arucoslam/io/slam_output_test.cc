@@ -42,7 +42,6 @@ TEST(SlamOutput, WritesFourFilesThatReadBack) {
   stats.whole_map_marker_adjustments = 2;
   stats.map_merges = 1;
   stats.marker_rejections = 4;
-  stats.drift_beyond_gate = 6;
   stats.refined_frame_poses = 17;
   stats.yielded_bundle_adjustments = 9;
   stats.radial_calibrations = 1;
@@ -66,7 +65,6 @@ TEST(SlamOutput, WritesFourFilesThatReadBack) {
   EXPECT_NE(json.find("\"whole_map_adjustments\": 2"), std::string::npos);
   EXPECT_NE(json.find("\"map_merges\": 1"), std::string::npos);
   EXPECT_NE(json.find("\"rejected_keypoint_poses\": 4"), std::string::npos);
-  EXPECT_NE(json.find("\"drift_beyond_gate\": 6"), std::string::npos);
   EXPECT_NE(json.find("\"refined_frame_poses\": 17"), std::string::npos);
   EXPECT_NE(json.find("\"yielded_bundle_adjustments\": 9"), std::string::npos);
   EXPECT_NE(json.find("\"radial_calibrations\": 1"), std::string::npos);

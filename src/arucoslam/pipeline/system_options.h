@@ -94,7 +94,7 @@ struct SystemOptions {
   // whole image.
   MarkerSearchOptions marker_search;
   // Each frame's marker location, its ambiguity, and the verdict on keypoint poses that
-  // contradict it (drift to correct, or a look-alike place).
+  // contradict it (a look-alike place).
   MarkerFusionOptions marker_fusion;
   // At Finish, when markers were mapped: frames posed by markers are located again in the
   // final marker map, and frames that saw markers but got no pose are located in it.

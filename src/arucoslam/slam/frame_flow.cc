@@ -106,7 +106,7 @@ void FrameFlow::Initialize(Frame& frame, FrameReport& report) {
   if (!step.map) return;
   if (step.map->in_world) {
     anchoring_.AlignedFromMarkers();  // re-aligned as anchors come
-    marker_fusion_.MapEnteredWorld(frame.timestamp_s);
+    marker_fusion_.MapEnteredWorld();
     lifecycle_.RefreshKeyframePoseCache(Parts());
     CountStat(&FrameFlowStats::num_marker_initializations);
   }
@@ -155,14 +155,12 @@ void FrameFlow::Track(Frame& frame, FrameReport& report) {
     frame.cam_from_world.reset();
     result.state = TrackingState::kLost;
   }
-  bool relocalized = false;
   if (result.state != TrackingState::kTracking &&
       (marker_world_.Relocalize(MarkerParts(), frame, report) ||
        lifecycle_.RelocalizeWithPlaces(Parts(), frame, report) ||
        lifecycle_.RelocalizeInLoadedMap(Parts(), frame, report))) {
     result.state = TrackingState::kTracking;
     result.num_inliers = report.num_inliers;
-    relocalized = true;
   }
   report.state = result.state;
   report.num_inliers = result.num_inliers;
@@ -177,7 +175,7 @@ void FrameFlow::Track(Frame& frame, FrameReport& report) {
   }
   last_state_ = TrackingState::kTracking;
   lifecycle_.session().OnTrackedFrame();
-  marker_fusion_.NoteTrackedFrame(frame, relocalized, anchoring_.aligned());
+  marker_fusion_.NoteTrackedFrame(frame, anchoring_.aligned());
   ++frames_since_keyframe_;
   MaybeInsertKeyframe(frame, result.num_inliers, report);
   report.cam_from_world = frame.cam_from_world;
@@ -204,11 +202,7 @@ void FrameFlow::MaybeInsertKeyframe(Frame& frame, int num_inliers, FrameReport& 
       marker_fusion_.fix() && !anchoring_.aligned() &&
       frames_since_keyframe_ >= options_.min_frames_between_anchor_keyframes &&
       num_inliers > options_.keyframes.min_tracked_points && input.mapper_has_room;
-  const bool wants_drift_keyframe = marker_fusion_.drift_keyframe_wanted() && input.mapper_has_room;
-  if (!wants_anchor && !wants_drift_keyframe && !DecideKeyframe(options_.keyframes, input).insert) {
-    return;
-  }
-  marker_fusion_.KeyframeInserted();
+  if (!wants_anchor && !DecideKeyframe(options_.keyframes, input).insert) return;
   const KeyframeId keyframe = InsertKeyframe(*map_, frame, tracker_->reference_keyframe());
   tracker_->SetReferenceKeyframe(keyframe);
   frames_since_keyframe_ = 0;

@@ -75,9 +75,6 @@ bool MarkerFusionOptions::Check(std::string* why) const {
   check.Nested("map_rotation_gates", map_rotation_gates);
   check.Nested("covisible_vote", covisible_vote);
   check.Above("max_marker_disagreement_m", max_marker_disagreement_m, 0.0);
-  check.AtLeast("min_drift_interval_s", min_drift_interval_s, 0.0);
-  check.AtLeast("max_drift_step_m", max_drift_step_m, 0.0);
-  check.AtLeast("max_drift_correction_frames", max_drift_correction_frames, 1);
   return check.ok();
 }
 

@@ -50,18 +50,6 @@ struct MarkerFusionOptions {
   // from the same frame's marker location is wrong (a look-alike place), and a pose found
   // by relocalisation is confirmed only when it lies this close.
   double max_marker_disagreement_m = 0.5;
-  // Drift, not a look-alike place: a disagreement is taken as drift when the map has been
-  // tracked without a break (no relocalisation the markers did not confirm, no new map) for
-  // at least min_drift_interval_s (seconds) since its markers last agreed with it. The pose
-  // is kept and a keyframe is wanted, whose marker location corrects the map; the next
-  // max_drift_correction_frames frames wait for that correction, after which a disagreement
-  // is a look-alike place again. Sooner after the markers agreed, a disagreement is drift
-  // only if it grew by at most max_drift_step_m (metres) since the previous frame with a
-  // marker location: the map does not drift half a metre at once.
-  bool correct_drift_beyond_gate = true;
-  double min_drift_interval_s = 2.0;
-  double max_drift_step_m = 0.25;
-  int max_drift_correction_frames = 15;
 
   bool Check(std::string* why = nullptr) const;
 };
@@ -88,7 +76,6 @@ struct MapPrediction {
 // What becomes of a tracked keypoint pose in a world-aligned map.
 enum class PoseVerdict {
   kAccepted,  // no marker location, or one that agrees with the pose
-  kDrift,     // contradicted, taken as drift: kept, and a keyframe to correct it is wanted
   kRejected,  // contradicted: a look-alike place, the frame is lost
 };
 
@@ -98,7 +85,6 @@ struct MarkerFusionStats {
   int num_map_rotation_disambiguations = 0;  // ... by the unaligned map's voted orientation
   int num_covisible_disambiguations = 0;     // ... by the markers seen with it
   int num_rejected_poses = 0;                // keypoint poses rejected by the markers
-  int num_drift_disagreements = 0;           // ... kept instead as drift to correct (first frames)
 };
 
 class MarkerFusion {
@@ -125,16 +111,12 @@ class MarkerFusion {
   // The tracked pose of the current frame (`frame.cam_from_world` set) judged against the
   // current fix; without `world_aligned` every pose is accepted.
   PoseVerdict JudgeTrackedPose(const Frame& frame, bool world_aligned, std::size_t frame_index);
-  // After a tracked (or relocalised) frame: in a world-aligned map, whether its markers agreed
-  // with the pose (`relocalized` and not confirmed: a break in the tracking's continuity);
-  // else its ambiguous marker votes for the world's orientation relative to the map.
-  void NoteTrackedFrame(const Frame& frame, bool relocalized, bool world_aligned);
-  // A kDrift verdict wants a keyframe until the next one is inserted.
-  bool drift_keyframe_wanted() const { return drift_keyframe_wanted_; }
-  void KeyframeInserted() { drift_keyframe_wanted_ = false; }
+  // After a tracked (or relocalised) frame of a map not yet in the world: its ambiguous
+  // marker votes for the world's orientation relative to the map.
+  void NoteTrackedFrame(const Frame& frame, bool world_aligned);
 
-  // The map was aligned to the world at `timestamp_s` (its anchors agree with it).
-  void MapEnteredWorld(double timestamp_s);
+  // The map was aligned to the world: its orientation votes are done with.
+  void MapEnteredWorld();
   // The map was discarded: what was learnt about it is forgotten (the fixes' motion stays).
   void MapReset();
 
@@ -163,12 +145,7 @@ class MarkerFusion {
   // The current fix's camera centre minus that of `cam_from_world` (needs fix_).
   Eigen::Vector3d MarkerOffset(const Rigid3& cam_from_world) const;
   bool Contradicts(const Rigid3& cam_from_world) const;
-  // A contradicted pose: true when the contradiction is drift to correct.
-  bool TakeDisagreementAsDrift(const Frame& frame, std::size_t frame_index);
-  void NoteAgreement(const Frame& frame, bool relocalized);
   void VoteForWorldRotation(const Frame& frame);
-  // Ends the tracking's continuity with its markers (and any drift being corrected).
-  void ForgetAgreement();
 
   MarkerFusionOptions options_;
   CameraModel camera_;
@@ -183,13 +160,6 @@ class MarkerFusion {
   WorldRotationVote rotation_vote_;
   CovisibleMarkerVote covisible_vote_;
   std::optional<CameraLocation> ambiguous_location_;
-  // Timestamp of the last frame whose marker location agreed with its keypoint pose, the map
-  // tracked without a break since (nullopt: not aligned, or broken since); the offset at the
-  // last fix; frames kept as drift since the first one; a keyframe wanted for the correction.
-  std::optional<double> markers_agreed_s_;
-  std::optional<Eigen::Vector3d> last_marker_offset_;
-  int drift_frames_ = 0;
-  bool drift_keyframe_wanted_ = false;
   MarkerFusionStats stats_;
 };
 

@@ -261,7 +261,7 @@ TEST(MarkerFusionTest, AmbiguousMarkerIsSettledByTheUnalignedMapsVotedOrientatio
     const AmbiguousView view = FindAmbiguousView(ObliqueOnMarker0(3.0, 12.0 + 2.0 * k), random);
     EXPECT_FALSE(fusion.Locate(view.detections, Board(), 0.1 * k, map, k)) << k;
     fusion.NoteTrackedFrame(TrackedFrame(0.1 * k, world_from_map.Inverse() * view.world_from_cam),
-                            false, false);
+                            false);
   }
   // The next ambiguous view is settled by the orientation the map predicts for it.
   const AmbiguousView view = FindAmbiguousView(ObliqueOnMarker0(3.0, 25.0), random);
@@ -295,14 +295,13 @@ class MarkerFusionVerdictTest : public ::testing::Test {
 };
 
 TEST_F(MarkerFusionVerdictTest, KeypointPoseFarFromTheMarkersIsRejected) {
-  fusion_.MapEnteredWorld(0.0);
+  fusion_.MapEnteredWorld();
   LocateAt(0.1);
   EXPECT_EQ(Judge(0.1, 0.2), PoseVerdict::kAccepted);  // within 0.5 m
   EXPECT_TRUE(fusion_.Confirms(Shifted(truth_, 0.2).Inverse()));
   // 1 m off, 0.1 s after the markers agreed with the map: a look-alike place.
   EXPECT_EQ(Judge(0.1, 1.0), PoseVerdict::kRejected);
   EXPECT_FALSE(fusion_.Confirms(Shifted(truth_, 1.0).Inverse()));
-  EXPECT_FALSE(fusion_.drift_keyframe_wanted());
   EXPECT_EQ(fusion_.stats().num_rejected_poses, 1);
   // Outside the marker world nothing is judged.
   EXPECT_EQ(fusion_.JudgeTrackedPose(TrackedFrame(0.1, Shifted(truth_, 1.0)), false, 0),
@@ -310,7 +309,7 @@ TEST_F(MarkerFusionVerdictTest, KeypointPoseFarFromTheMarkersIsRejected) {
 }
 
 TEST_F(MarkerFusionVerdictTest, WithoutMarkerLocationEveryPoseIsAccepted) {
-  fusion_.MapEnteredWorld(0.0);
+  fusion_.MapEnteredWorld();
   MapPrediction map;
   map.world_aligned = true;
   EXPECT_FALSE(fusion_.Locate({}, Board(), 0.1, map, 0));
@@ -318,69 +317,26 @@ TEST_F(MarkerFusionVerdictTest, WithoutMarkerLocationEveryPoseIsAccepted) {
   EXPECT_FALSE(fusion_.Confirms(truth_.Inverse()));  // and no relocalisation is confirmed
 }
 
-TEST_F(MarkerFusionVerdictTest, DisagreementLongAfterTheMarkersAgreedIsDrift) {
-  fusion_.MapEnteredWorld(0.0);
+TEST_F(MarkerFusionVerdictTest, DisagreementIsRejectedHoweverLongAfterTheMarkersAgreed) {
+  fusion_.MapEnteredWorld();
   LocateAt(0.0);
-  fusion_.NoteTrackedFrame(TrackedFrame(0.0, truth_), false, true);  // agrees at t = 0
-  // 3 s later (min_drift_interval_s 2) the map is 0.8 m off: drift, a keyframe is wanted.
+  fusion_.NoteTrackedFrame(TrackedFrame(0.0, Shifted(truth_, 0.4)), true);  // within the gate
+  // 0.1 s later the offset has grown to 0.6 m, 3 s later it is 0.8 m: each beyond the 0.5 m
+  // gate, each rejected; the map's drift is corrected only by keyframes within the gate.
+  LocateAt(0.1);
+  EXPECT_EQ(Judge(0.1, 0.6), PoseVerdict::kRejected);
   LocateAt(3.0);
-  EXPECT_EQ(Judge(3.0, 0.8), PoseVerdict::kDrift);
-  EXPECT_TRUE(fusion_.drift_keyframe_wanted());
-  fusion_.KeyframeInserted();
-  EXPECT_FALSE(fusion_.drift_keyframe_wanted());
-  EXPECT_EQ(fusion_.stats().num_drift_disagreements, 1);
-  // The following frames wait for the correction, max_drift_correction_frames (15) in all ...
-  for (int i = 1; i < 15; ++i) {
-    LocateAt(3.0 + 0.1 * i);
-    EXPECT_EQ(Judge(3.0 + 0.1 * i, 0.8), PoseVerdict::kDrift) << i;
-  }
-  // ... after which the disagreement is a wrong place.
-  LocateAt(4.5);
-  EXPECT_EQ(Judge(4.5, 0.8), PoseVerdict::kRejected);
-  EXPECT_EQ(fusion_.stats().num_drift_disagreements, 1);
-  EXPECT_EQ(fusion_.stats().num_rejected_poses, 1);
-}
-
-TEST_F(MarkerFusionVerdictTest, DisagreementGrowingGraduallyIsDrift) {
-  fusion_.MapEnteredWorld(0.0);
-  LocateAt(0.0);
-  fusion_.NoteTrackedFrame(TrackedFrame(0.0, Shifted(truth_, 0.4)), false, true);
-  // 0.1 s later the offset grew from 0.4 to 0.6 m: by less than max_drift_step_m (0.25).
-  LocateAt(0.1);
-  EXPECT_EQ(Judge(0.1, 0.6), PoseVerdict::kDrift);
-
-  // From 0.4 m to 0.9 m at once: a jump, rejected.
-  MarkerFusion jump = MakeFusion();
-  jump.MapEnteredWorld(0.0);
+  EXPECT_EQ(Judge(3.0, 0.8), PoseVerdict::kRejected);
+  EXPECT_EQ(fusion_.stats().num_rejected_poses, 2);
+  // A wider gate accepts the same pose.
+  MarkerFusionOptions wide;
+  wide.max_marker_disagreement_m = 1.0;
+  MarkerFusion lenient = MakeFusion(wide);
   MapPrediction map;
   map.world_aligned = true;
-  ASSERT_TRUE(jump.Locate(Detect(truth_, {0, 1, 2, 3}, random_), Board(), 0.0, map, 0));
-  jump.NoteTrackedFrame(TrackedFrame(0.0, Shifted(truth_, 0.4)), false, true);
-  ASSERT_TRUE(jump.Locate(Detect(truth_, {0, 1, 2, 3}, random_), Board(), 0.1, map, 1));
-  EXPECT_EQ(jump.JudgeTrackedPose(TrackedFrame(0.1, Shifted(truth_, 0.9)), true, 1),
-            PoseVerdict::kRejected);
-}
-
-TEST_F(MarkerFusionVerdictTest, RelocalisationTheMarkersDoNotConfirmBreaksTheTracking) {
-  fusion_.MapEnteredWorld(0.0);
-  LocateAt(0.0);
-  fusion_.NoteTrackedFrame(TrackedFrame(0.0, truth_), false, true);
-  // A relocalisation 1 m off the markers: from here the map's continuity is unknown, and a
-  // later disagreement, however long after, is not taken as drift.
-  LocateAt(0.1);
-  fusion_.NoteTrackedFrame(TrackedFrame(0.1, Shifted(truth_, 1.0)), true, true);
-  LocateAt(5.0);
-  EXPECT_EQ(Judge(5.0, 0.8), PoseVerdict::kRejected);
-  // The drift rule off: the same disagreement as in the drift test is rejected.
-  MarkerFusionOptions off;
-  off.correct_drift_beyond_gate = false;
-  MarkerFusion strict = MakeFusion(off);
-  strict.MapEnteredWorld(0.0);
-  MapPrediction map;
-  map.world_aligned = true;
-  ASSERT_TRUE(strict.Locate(Detect(truth_, {0, 1, 2, 3}, random_), Board(), 3.0, map, 0));
-  EXPECT_EQ(strict.JudgeTrackedPose(TrackedFrame(3.0, Shifted(truth_, 0.8)), true, 0),
-            PoseVerdict::kRejected);
+  ASSERT_TRUE(lenient.Locate(Detect(truth_, {0, 1, 2, 3}, random_), Board(), 3.0, map, 0));
+  EXPECT_EQ(lenient.JudgeTrackedPose(TrackedFrame(3.0, Shifted(truth_, 0.8)), true, 0),
+            PoseVerdict::kAccepted);
 }
 
 TEST(MarkerFusionTest, LocatesInAnotherMapWithTheFramesEarlierPose) {
@@ -417,9 +373,9 @@ TEST(MarkerFusionTest, OptionsSayWhatIsWrong) {
   EXPECT_FALSE(options.Check(&why));
   EXPECT_NE(why.find("rotation_vote.min_support"), std::string::npos) << why;
   options = {};
-  options.max_drift_correction_frames = 0;
+  options.max_marker_disagreement_m = 0.0;
   EXPECT_FALSE(options.Check(&why));
-  EXPECT_NE(why.find("max_drift_correction_frames"), std::string::npos) << why;
+  EXPECT_NE(why.find("max_marker_disagreement_m"), std::string::npos) << why;
 }
 
 }  // namespace

@@ -71,7 +71,7 @@ void MarkerWorld::MaybeAlign(const MarkerWorldParts& parts, Frame& frame) {
       anchoring.aligned() ? "re-" : "", world_from_map.scale, alignment.num_inliers, anchors.size(),
       alignment.rms_m);
   anchoring.AlignmentApplied(*decision);
-  parts.marker_fusion.MapEnteredWorld(frame.timestamp_s);  // the anchors agree with the map
+  parts.marker_fusion.MapEnteredWorld();
   parts.lifecycle.RefreshKeyframePoseCache(parts.ForLifecycle());
 }
 

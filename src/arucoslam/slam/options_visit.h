@@ -316,14 +316,6 @@ void VisitOptions(MarkerFusionOptions& o, Visitor& visit) {
   visit("covisible_vote", o.covisible_vote, "that vote");
   visit("max_marker_disagreement_m", o.max_marker_disagreement_m,
         "a keypoint pose farther than this from the frame's marker location is wrong, metres");
-  visit("correct_drift_beyond_gate", o.correct_drift_beyond_gate,
-        "such a disagreement after steady tracking is drift, corrected with the markers");
-  visit("min_drift_interval_s", o.min_drift_interval_s,
-        "drift when tracked without a break this long since the markers agreed, seconds");
-  visit("max_drift_step_m", o.max_drift_step_m,
-        "sooner: drift only when the disagreement grew at most this since the last, metres");
-  visit("max_drift_correction_frames", o.max_drift_correction_frames,
-        "frames that wait for a drift correction");
 }
 
 template <class Visitor>
