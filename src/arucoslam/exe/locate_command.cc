@@ -102,9 +102,6 @@ void PrintText(const CameraLocation& location) {
 int RunLocate(const LocateArgs& args) {
   const CameraModel camera = ReadCameraModel(args.camera);
   const MarkerMap map = ReadMarkerMapJson(args.markers);
-  if (!std::filesystem::is_regular_file(args.image)) {
-    throw InputError(args.image, "image file not found");
-  }
   const cv::Mat image = ReadImageFile(args.image, cv::IMREAD_UNCHANGED);
   if (image.cols != camera.width || image.rows != camera.height) {
     throw InputError(args.image, "image is " + std::to_string(image.cols) + "x" +

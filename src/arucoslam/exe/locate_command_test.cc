@@ -131,13 +131,16 @@ TEST_F(LocateCommandTest, NoKnownMarkerExitsOneWithAReason) {
 
 TEST_F(LocateCommandTest, BadInputIsOneLineAndStatusTwo) {
   WriteScene({3});
-  for (const std::string& arguments : {"locate --image " + (folder_ / "missing.png").string() +
-                                           " --camera " + (folder_ / "camera.yaml").string() +
-                                           " --markers " + (folder_ / "markers.json").string(),
-                                       "locate --image " + (folder_ / "camera.yaml").string() +
-                                           " --camera " + (folder_ / "camera.yaml").string() +
-                                           " --markers " + (folder_ / "markers.json").string(),
-                                       Args(" --refinement sharp")}) {
+  for (const std::string& arguments :
+       {"locate --image " + (folder_ / "missing.png").string() + " --camera " +
+            (folder_ / "camera.yaml").string() + " --markers " +
+            (folder_ / "markers.json").string(),
+        "locate --image " + (folder_ / "camera.yaml").string() + " --camera " +
+            (folder_ / "camera.yaml").string() + " --markers " +
+            (folder_ / "markers.json").string(),
+        "locate --image " + folder_.string() + " --camera " + (folder_ / "camera.yaml").string() +
+            " --markers " + (folder_ / "markers.json").string(),
+        Args(" --refinement sharp")}) {
     const RunResult result = Run(arguments);
     EXPECT_EQ(result.status, 2) << arguments;
     EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;

@@ -49,6 +49,9 @@ std::optional<std::string> JpegLayoutDefect(std::string_view bytes) {
 
 cv::Mat ReadImageFile(const std::filesystem::path& path, int cv_imread_flags) {
   if (!std::filesystem::exists(path)) throw InputError(path.string(), "image not found");
+  if (!std::filesystem::is_regular_file(path)) {
+    throw InputError(path.string(), "is not a file (an image was expected)");
+  }
   const std::string bytes = ReadTextFile(path);  // the whole file, as bytes
   std::optional<std::string> defect = PngLayoutDefect(bytes);
   if (!defect) defect = JpegLayoutDefect(bytes);

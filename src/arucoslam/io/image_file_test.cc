@@ -75,6 +75,7 @@ TEST_F(ImageFileTest, ATruncatedPngIsNamedAsSuchWithoutTheDecodersOwnMessages) {
 
 TEST_F(ImageFileTest, MissingFilesAndFilesThatAreNoImageAreNamed) {
   EXPECT_EQ(ErrorOf(folder_ / "absent.png"), "image not found");
+  EXPECT_EQ(ErrorOf(folder_), "is not a file (an image was expected)");
   const std::string text = "not an image\n";
   EXPECT_EQ(ErrorOf(Write("notes.png", text)), "cannot read the image (not an image or corrupt)");
   EXPECT_EQ(ErrorOf(Write("empty.png", {})), "cannot read the image (not an image or corrupt)");
