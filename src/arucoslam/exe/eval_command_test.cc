@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -11,6 +10,7 @@
 
 #include "arucoslam/exe/command_test_util.h"
 #include "arucoslam/util/files.h"
+#include "arucoslam/util/scratch_folder.h"
 
 namespace arucoslam {
 namespace {
@@ -23,15 +23,6 @@ using RunResult = testing_util::SplitCommandResult;
 
 class EvalCommandTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    folder_ = fs::temp_directory_path() /
-              ("eval_command_test_" + std::to_string(getpid()) + "_" +
-               ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(folder_);
-    fs::create_directories(folder_);
-  }
-  void TearDown() override { fs::remove_all(folder_); }
-
   RunResult Run(const std::string& arguments) const {
     return testing_util::RunArucoslamSplit("eval " + arguments, folder_);
   }
@@ -52,7 +43,8 @@ class EvalCommandTest : public ::testing::Test {
     return folder_ / name;
   }
 
-  fs::path folder_;
+  ScratchFolder scratch_{"eval_command_test"};
+  const fs::path& folder_ = scratch_.path();
 };
 
 TEST_F(EvalCommandTest, ReproducesEvoAndWritesResultsAndPlots) {

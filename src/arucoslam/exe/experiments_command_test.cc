@@ -1,7 +1,6 @@
 // End to end: `arucoslam demo` on the first seconds of the default factory renders both
 // sequences, runs the methods, and writes a table and a report; bad input exits with 2.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -12,6 +11,7 @@
 
 #include "arucoslam/exe/command_test_util.h"
 #include "arucoslam/util/files.h"
+#include "arucoslam/util/scratch_folder.h"
 
 namespace arucoslam {
 namespace {
@@ -42,13 +42,8 @@ std::vector<std::string> TableRow(const std::string& table, const std::string& m
 
 class ExperimentsCommandTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("arucoslam_experiments_test_" + std::to_string(getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
+  ScratchFolder scratch_{"experiments_test"};
+  const fs::path& dir_ = scratch_.path();
 };
 
 TEST_F(ExperimentsCommandTest, DemoOnTheFirstSecondsWritesTableAndReport) {

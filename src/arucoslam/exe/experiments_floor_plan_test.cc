@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "arucoslam/util/error.h"
+#include "arucoslam/util/scratch_folder.h"
 
 namespace arucoslam {
 namespace {
@@ -15,8 +16,6 @@ namespace fs = std::filesystem;
 class FloorPlanTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("arucoslam_floor_plan_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
     std::ofstream(dir_ / "world.sdf") << R"(<?xml version="1.0"?><sdf version="1.9">
 <world name="w"><model name="m"><static>true</static><link name="l">
   <visual name="rack"><pose>2 1 1 0 0 0</pose><geometry><box><size>3 0.5 2</size></box></geometry></visual>
@@ -24,9 +23,9 @@ class FloorPlanTest : public ::testing::Test {
     <geometry><cylinder><radius>0.2</radius><length>2</length></cylinder></geometry></visual>
 </link></model></world></sdf>)";
   }
-  void TearDown() override { fs::remove_all(dir_); }
 
-  fs::path dir_;
+  ScratchFolder scratch_{"floor_plan"};
+  const fs::path& dir_ = scratch_.path();
 };
 
 Trajectory Line(int n) {

@@ -4,7 +4,6 @@
 // 10 s render the 2 s allowed for initialisation alone would be 20%), Sim(3) ATE <= 2% of
 // the distance travelled.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -16,6 +15,7 @@
 #include "arucoslam/eval/association.h"
 #include "arucoslam/exe/command_test_util.h"
 #include "arucoslam/io/trajectory_io.h"
+#include "arucoslam/util/scratch_folder.h"
 
 namespace arucoslam {
 namespace {
@@ -43,10 +43,8 @@ double FirstTurnStart(const Trajectory& gt, double angle) {
 }
 
 TEST(KeypointSlamAcceptance, MediumTextureTracksUpToTheTightTurn) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("arucoslam_acceptance_test_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const ScratchFolder scratch("acceptance_test");
+  const fs::path& dir = scratch.path();
   const CommandResult world =
       RunArucoslam("world factory --seed 1 --texture medium --markers off --aisles 1 "
                    "--aisle-length 6 --out " + (dir / "world").string());
@@ -115,7 +113,6 @@ TEST(KeypointSlamAcceptance, MediumTextureTracksUpToTheTightTurn) {
   std::printf("init %.2f s, tracked %.1f%% of the %zu frames from then to the turn at %.2f s, "
               "Sim3 ATE %.4f m over %.2f m (%.2f%%)\n",
               init_s, 100.0 * tracked, gt_frames, turn, ate, distance, 100.0 * ate / distance);
-  fs::remove_all(dir);
 }
 
 }  // namespace

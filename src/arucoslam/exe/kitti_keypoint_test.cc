@@ -2,7 +2,6 @@
 // of KITTI odometry 07 (a car turning out of a junction, then 90 m of street). Holds the share
 // of frames posed and the Sim(3) ATE against the official poses; skipped without the data.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -14,6 +13,7 @@
 #include "arucoslam/exe/command_test_util.h"
 #include "arucoslam/io/trajectory_io.h"
 #include "arucoslam/util/files.h"
+#include "arucoslam/util/scratch_folder.h"
 
 namespace arucoslam {
 namespace {
@@ -27,9 +27,8 @@ TEST(KittiKeypointSlam, First160FramesOfSequence07) {
   if (!fs::exists(sequence / "mav0" / "cam0" / "data.csv")) {
     GTEST_SKIP() << "no KITTI data under " << sequence;
   }
-  const fs::path out =
-      fs::temp_directory_path() / ("arucoslam_kitti_test_" + std::to_string(::getpid()));
-  fs::remove_all(out);
+  const ScratchFolder scratch("kitti_test");
+  const fs::path out = scratch.path() / "run";
   const CommandResult run = RunArucoslam("run --dataset " + sequence.string() + " --out " +
                                          out.string() + " --blocking --no-markers --quiet");
   ASSERT_EQ(run.status, 0) << run.output;
@@ -67,7 +66,6 @@ TEST(KittiKeypointSlam, First160FramesOfSequence07) {
     steps_mean += timings[step]["mean"].get<double>();
   }
   EXPECT_LE(steps_mean, whole["mean"].get<double>());
-  fs::remove_all(out);
 }
 
 }  // namespace

@@ -4,7 +4,6 @@
 
 #include "arucoslam/exe/command_test_util.h"
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -16,6 +15,7 @@
 #include "arucoslam/io/marker_map_json.h"
 #include "arucoslam/markers/synthetic_view.h"
 #include "arucoslam/util/files.h"
+#include "arucoslam/util/scratch_folder.h"
 
 namespace arucoslam {
 namespace {
@@ -26,15 +26,6 @@ using RunResult = testing_util::SplitCommandResult;
 
 class LocateCommandTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    folder_ = fs::temp_directory_path() /
-              ("locate_command_test_" + std::to_string(getpid()) + "_" +
-               ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(folder_);
-    fs::create_directories(folder_);
-  }
-  void TearDown() override { fs::remove_all(folder_); }
-
   RunResult Run(const std::string& arguments) const {
     return testing_util::RunArucoslamSplit(arguments, folder_);
   }
@@ -85,7 +76,8 @@ class LocateCommandTest : public ::testing::Test {
            (folder_ / "markers.json").string() + extra;
   }
 
-  fs::path folder_;
+  ScratchFolder scratch_{"locate_command_test"};
+  const fs::path& folder_ = scratch_.path();
 };
 
 Eigen::Vector3d Position(const nlohmann::json& pose) {

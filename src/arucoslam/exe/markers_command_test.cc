@@ -3,7 +3,6 @@
 
 #include "arucoslam/exe/command_test_util.h"
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -19,6 +18,7 @@
 #include "arucoslam/io/marker_map_json.h"
 #include "arucoslam/markers/dictionary.h"
 #include "arucoslam/util/files.h"
+#include "arucoslam/util/scratch_folder.h"
 
 namespace arucoslam {
 namespace {
@@ -29,20 +29,12 @@ using RunResult = testing_util::SplitCommandResult;
 
 class MarkersCommandTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    folder_ = fs::temp_directory_path() /
-              ("markers_command_test_" + std::to_string(getpid()) + "_" +
-               ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(folder_);
-    fs::create_directories(folder_);
-  }
-  void TearDown() override { fs::remove_all(folder_); }
-
   RunResult Run(const std::string& arguments) const {
     return testing_util::RunArucoslamSplit(arguments, folder_);
   }
 
-  fs::path folder_;
+  ScratchFolder scratch_{"markers_command_test"};
+  const fs::path& folder_ = scratch_.path();
 };
 
 TEST_F(MarkersCommandTest, GenerateWritesDetectableMarkersAndAValidTemplate) {

@@ -28,6 +28,7 @@
 #include "arucoslam/markers/camera_locator.h"
 #include "arucoslam/markers/detector.h"
 #include "arucoslam/util/files.h"
+#include "arucoslam/util/scratch_folder.h"
 
 namespace arucoslam {
 namespace {
@@ -41,20 +42,12 @@ const fs::path kLifecam = kData / "photonvision_charuco_lifecam";
 
 class RealInputsTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("arucoslam_real_inputs_test_" + std::to_string(getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   SplitCommandResult Run(const std::string& arguments) const {
     return RunArucoslamSplit(arguments, dir_);
   }
 
-  fs::path dir_;
+  ScratchFolder scratch_{"real_inputs_test"};
+  const fs::path& dir_ = scratch_.path();
 };
 
 // The ChArUco board's 32 markers from the data set's layout file (board frame: x right, y down,

@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -19,6 +18,7 @@
 #include "arucoslam/io/marker_map_json.h"
 #include "arucoslam/io/trajectory_io.h"
 #include "arucoslam/util/files.h"
+#include "arucoslam/util/scratch_folder.h"
 
 namespace arucoslam {
 namespace {
@@ -29,18 +29,12 @@ using Outcome = testing_util::SplitCommandResult;
 
 class RunCommandTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("arucoslam_run_test_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   Outcome Run(const std::string& arguments) const {
     return testing_util::RunArucoslamSplit(arguments, dir_);
   }
 
-  fs::path dir_;
+  ScratchFolder scratch_{"run_test"};
+  const fs::path& dir_ = scratch_.path();
 };
 
 int CountLines(const std::string& text, char skip_prefix) {

@@ -2,7 +2,6 @@
 
 #include "arucoslam/exe/command_test_util.h"
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include <array>
 #include <cstdio>
@@ -13,6 +12,7 @@
 #include <string>
 
 #include "arucoslam/feature/vocabulary.h"
+#include "arucoslam/util/scratch_folder.h"
 
 namespace arucoslam {
 namespace {
@@ -28,8 +28,6 @@ int CountLines(const std::string& text) {
 class VocabCommandTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("arucoslam_vocab_command_test_" + std::to_string(getpid()));
-    fs::remove_all(dir_);
     fs::create_directories(dir_ / "images" / "sub");
     // Textured images (blurred noise with shapes), some in a subfolder.
     cv::RNG rng(5);
@@ -46,8 +44,8 @@ class VocabCommandTest : public ::testing::Test {
     }
     std::ofstream(dir_ / "images" / "notes.txt") << "not an image\n";
   }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
+  ScratchFolder scratch_{"vocab_command_test"};
+  const fs::path& dir_ = scratch_.path();
 };
 
 TEST_F(VocabCommandTest, TrainsFromAFolderAndInfoDescribesIt) {

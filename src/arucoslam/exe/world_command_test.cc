@@ -2,7 +2,6 @@
 
 #include "arucoslam/exe/command_test_util.h"
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -12,6 +11,7 @@
 
 #include "arucoslam/io/marker_map_json.h"
 #include "arucoslam/io/path_json.h"
+#include "arucoslam/util/scratch_folder.h"
 
 namespace arucoslam {
 namespace {
@@ -22,13 +22,8 @@ using testing_util::RunArucoslam;
 
 class WorldCommandTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("arucoslam_world_command_test_" + std::to_string(getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
+  ScratchFolder scratch_{"world_command_test"};
+  const fs::path& dir_ = scratch_.path();
 };
 
 TEST_F(WorldCommandTest, WritesTheFactoryFolder) {

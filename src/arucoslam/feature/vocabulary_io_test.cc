@@ -1,5 +1,4 @@
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -7,6 +6,7 @@
 
 #include "arucoslam/feature/vocabulary.h"
 #include "arucoslam/util/error.h"
+#include "arucoslam/util/scratch_folder.h"
 
 namespace arucoslam {
 namespace {
@@ -47,12 +47,8 @@ void PutU32(std::string& bytes, std::size_t offset, std::uint32_t value) {
 
 class VocabularyIoTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("arucoslam_vocabulary_io_test_" + std::to_string(getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
+  ScratchFolder scratch_{"vocabulary_io_test"};
+  const fs::path& dir_ = scratch_.path();
 };
 
 TEST_F(VocabularyIoTest, FileRoundTripIsExact) {

@@ -10,6 +10,7 @@
 #include "arucoslam/io/calibration.h"
 #include "arucoslam/io/trajectory_io.h"
 #include "arucoslam/util/error.h"
+#include "arucoslam/util/scratch_folder.h"
 
 namespace arucoslam {
 namespace {
@@ -48,15 +49,6 @@ CameraModel SmallCamera() {
 
 class DatasetReaderTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    folder_ = fs::temp_directory_path() /
-              ("arucoslam_dataset_test_" +
-               std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(folder_);
-    fs::create_directories(folder_);
-  }
-  void TearDown() override { fs::remove_all(folder_); }
-
   // A EuRoC sequence of `n` 64x48 frames, 100 ms apart, with the small camera.
   fs::path MakeEuroc(int n) {
     const fs::path cam = folder_ / "seq" / "mav0" / "cam0";
@@ -73,7 +65,8 @@ class DatasetReaderTest : public ::testing::Test {
     return folder_ / "seq";
   }
 
-  fs::path folder_;
+  ScratchFolder scratch_{"dataset_test"};
+  const fs::path& folder_ = scratch_.path();
 };
 
 TEST_F(DatasetReaderTest, EurocMicroRealSequence) {

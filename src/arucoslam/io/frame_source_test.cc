@@ -1,7 +1,6 @@
 #include "arucoslam/io/frame_source.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
@@ -11,6 +10,7 @@
 #include "arucoslam/io/calibration.h"
 #include "arucoslam/util/error.h"
 #include "arucoslam/util/files.h"
+#include "arucoslam/util/scratch_folder.h"
 
 namespace arucoslam {
 namespace {
@@ -19,13 +19,9 @@ namespace fs = std::filesystem;
 class FrameSourceTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("arucoslam_frame_source_test_" + std::to_string(getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
     camera_path_ = dir_ / "camera.yaml";
     WriteEuRoCSensorYaml(PinholeCamera(64, 48, 50.0), camera_path_);
   }
-  void TearDown() override { fs::remove_all(dir_); }
 
   std::string ErrorOf(const fs::path& path, const DatasetOptions& options) {
     try {
@@ -37,7 +33,8 @@ class FrameSourceTest : public ::testing::Test {
     return "no error";
   }
 
-  fs::path dir_;
+  ScratchFolder scratch_{"frame_source_test"};
+  const fs::path& dir_ = scratch_.path();
   fs::path camera_path_;
 };
 

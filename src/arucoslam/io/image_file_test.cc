@@ -8,6 +8,7 @@
 
 #include "arucoslam/util/error.h"
 #include "arucoslam/util/files.h"
+#include "arucoslam/util/scratch_folder.h"
 
 namespace arucoslam {
 namespace {
@@ -17,17 +18,11 @@ namespace fs = std::filesystem;
 class ImageFileTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    folder_ = fs::temp_directory_path() /
-              ("arucoslam_image_file_test_" +
-               std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(folder_);
-    fs::create_directories(folder_);
     image_ = cv::Mat(48, 64, CV_8UC1);
     cv::randu(image_, 0, 255);  // incompressible: the IDAT chunk is most of the file
     ASSERT_TRUE(cv::imwrite((folder_ / "frame.png").string(), image_));
     png_ = ReadTextFile(folder_ / "frame.png");
   }
-  void TearDown() override { fs::remove_all(folder_); }
 
   fs::path Write(const std::string& name, const std::string& bytes) {
     const fs::path path = folder_ / name;
@@ -45,7 +40,8 @@ class ImageFileTest : public ::testing::Test {
     return "";
   }
 
-  fs::path folder_;
+  ScratchFolder scratch_{"image_file_test"};
+  const fs::path& folder_ = scratch_.path();
   cv::Mat image_;
   std::string png_;
 };

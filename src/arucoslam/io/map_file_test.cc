@@ -13,6 +13,7 @@
 
 #include "arucoslam/util/error.h"
 #include "arucoslam/util/files.h"
+#include "arucoslam/util/scratch_folder.h"
 
 namespace arucoslam {
 namespace {
@@ -231,13 +232,6 @@ std::string Resign(std::string bytes) {
   return bytes;
 }
 
-fs::path TestDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("arucoslam_map_file_test_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
 TEST(MapFileTest, Fnv1aMatchesReferenceValues) {
   // Published FNV-1a 64-bit test vectors.
   EXPECT_EQ(Fnv1a64(""), 0xcbf29ce484222325ULL);
@@ -280,7 +274,8 @@ TEST(MapFileTest, EmptyMapRoundTrips) {
 }
 
 TEST(MapFileTest, SaveAndLoadFilesAndSharedMap) {
-  const fs::path dir = TestDir("files");
+  const ScratchFolder scratch("map_file_test");
+  const fs::path& dir = scratch.path();
   const MapData original = BuildTestMap(6, 40, 100, 3);
   SaveMapFile(original, dir / "a.map");
   SaveMapFile(original, dir / "a.map");  // replaces the file
@@ -297,11 +292,11 @@ TEST(MapFileTest, SaveAndLoadFilesAndSharedMap) {
   EXPECT_THROW(LoadMapFile(dir / "bad.map", map), InputError);
   EXPECT_EQ(map.NumKeyframes(), original.NumKeyframes());
   EXPECT_THROW(SaveMapFile(original, dir / "missing_folder" / "c.map"), InputError);
-  fs::remove_all(dir);
 }
 
 TEST(MapFileTest, MissingFileNamesIt) {
-  const fs::path path = TestDir("missing") / "nothing.map";
+  const ScratchFolder scratch("map_file_test");
+  const fs::path path = scratch.path() / "nothing.map";
   try {
     LoadMapFile(path);
     FAIL() << "no error";
@@ -309,7 +304,6 @@ TEST(MapFileTest, MissingFileNamesIt) {
     EXPECT_EQ(error.source(), path.string());
     EXPECT_NE(error.message().find("does not exist"), std::string::npos) << error.message();
   }
-  fs::remove_all(path.parent_path());
 }
 
 TEST(MapFileTest, WrongMagicIsNotAMap) {

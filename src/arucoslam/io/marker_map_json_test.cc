@@ -1,7 +1,6 @@
 #include "arucoslam/io/marker_map_json.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <functional>
@@ -10,6 +9,7 @@
 
 #include "arucoslam/util/error.h"
 #include "arucoslam/util/files.h"
+#include "arucoslam/util/scratch_folder.h"
 
 namespace arucoslam {
 namespace {
@@ -109,15 +109,13 @@ TEST(MarkerMapJsonTest, RoundTripIsExact) {
 }
 
 TEST(MarkerMapJsonTest, FileRoundTripAndMissingFile) {
-  const std::filesystem::path folder =
-      std::filesystem::temp_directory_path() / ("marker_map_json_test_" + std::to_string(getpid()));
-  std::filesystem::create_directories(folder);
+  const ScratchFolder scratch("marker_map_json_test");
+  const std::filesystem::path& folder = scratch.path();
   const MarkerMap map = RandomMap(3, 5);
   WriteMarkerMapJson(map, folder / "markers.json");
   const MarkerMap back = ReadMarkerMapJson(folder / "markers.json");
   EXPECT_EQ(MarkerMapToJson(back), MarkerMapToJson(map));
   EXPECT_THROW(ReadMarkerMapJson(folder / "absent.json"), InputError);
-  std::filesystem::remove_all(folder);
 }
 
 TEST(MarkerMapJsonTest, WriteRefusesAMapThatWouldNotReadBack) {

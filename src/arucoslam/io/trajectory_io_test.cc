@@ -7,6 +7,7 @@
 
 #include "arucoslam/util/error.h"
 #include "arucoslam/util/files.h"
+#include "arucoslam/util/scratch_folder.h"
 
 namespace arucoslam {
 namespace {
@@ -159,9 +160,8 @@ TEST(TrajectoryIo, ReadsEvoTestData) {
 }
 
 TEST(TrajectoryIo, WriteIsAtomicAndReadable) {
-  const fs::path dir = fs::temp_directory_path() / "arucoslam_trajectory_io_test";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const ScratchFolder scratch("trajectory_io_test");
+  const fs::path& dir = scratch.path();
   Trajectory trajectory;
   trajectory.Add(0.0, Rigid3());
   trajectory.Add(0.1, Rigid3(Eigen::Quaterniond(0, 1, 0, 0), Eigen::Vector3d(1, 0, 0)));
@@ -171,7 +171,6 @@ TEST(TrajectoryIo, WriteIsAtomicAndReadable) {
   EXPECT_EQ(back.poses[1].rotation.x(), 1.0);
   EXPECT_NE(ErrorOf([&] { ReadTrajectory(dir / "missing.txt"); }).find("missing.txt"),
             std::string::npos);
-  fs::remove_all(dir);
 }
 
 }  // namespace

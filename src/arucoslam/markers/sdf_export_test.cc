@@ -18,6 +18,7 @@
 #include <sdf/World.hh>
 
 #include "arucoslam/util/error.h"
+#include "arucoslam/util/scratch_folder.h"
 
 namespace arucoslam {
 namespace {
@@ -96,10 +97,8 @@ TEST(SdfExportTest, RejectsBadSizeAndOptions) {
 
 // Writes the folder, parses it back with libsdformat and compares every model with the map.
 TEST(SdfExportTest, ParsedBackWorldMatchesTheMap) {
-  const fs::path folder =
-      fs::temp_directory_path() / ("sdf_export_test_" + std::to_string(::getpid()));
-  fs::remove_all(folder);
-  fs::create_directories(folder);
+  const ScratchFolder scratch("sdf_export_test");
+  const fs::path& folder = scratch.path();
   const MarkerMap map = TestMap();
   MarkerImageOptions image;
   image.marker_size_px = 120;
@@ -148,7 +147,6 @@ TEST(SdfExportTest, ParsedBackWorldMatchesTheMap) {
     EXPECT_EQ(png.at<uchar>(0, 0), 255);  // white quiet zone
     EXPECT_EQ(png.at<uchar>(45, 45), 0);  // black border of the marker
   }
-  fs::remove_all(folder);
 }
 
 }  // namespace

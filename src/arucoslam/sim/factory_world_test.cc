@@ -1,7 +1,6 @@
 #include "arucoslam/sim/factory_world.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -16,6 +15,7 @@
 #include "arucoslam/sim/path.h"
 #include "arucoslam/sim/world_model.h"
 #include "arucoslam/util/error.h"
+#include "arucoslam/util/scratch_folder.h"
 
 namespace arucoslam {
 namespace {
@@ -25,13 +25,6 @@ constexpr double kPi = std::numbers::pi;
 
 class FactoryWorldTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    root_ = fs::temp_directory_path() / ("arucoslam_factory_test_" + std::to_string(getpid()));
-    fs::remove_all(root_);
-    fs::create_directories(root_);
-  }
-  void TearDown() override { fs::remove_all(root_); }
-
   fs::path Write(const FactoryOptions& options, const std::string& name) {
     const fs::path dir = root_ / name;
     fs::create_directories(dir);
@@ -39,7 +32,8 @@ class FactoryWorldTest : public ::testing::Test {
     return dir;
   }
 
-  fs::path root_;
+  ScratchFolder scratch_{"factory_test"};
+  const fs::path& root_ = scratch_.path();
 };
 
 std::string FileBytes(const fs::path& path) {

@@ -6,9 +6,9 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
-#include <unistd.h>
 
 #include "arucoslam/util/error.h"
+#include "arucoslam/util/scratch_folder.h"
 
 namespace arucoslam {
 namespace {
@@ -23,9 +23,6 @@ void WriteFile(const fs::path& path, const std::string& text) {
 class WorldModelTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("arucoslam_world_model_test_" + std::to_string(getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
     // A 1x1 PNG is enough for path resolution (the loader does not decode it).
     WriteFile(dir_ / "crate" / "textures" / "wood.png", "png");
     WriteFile(dir_ / "crate" / "model.config",
@@ -39,7 +36,6 @@ class WorldModelTest : public ::testing::Test {
         <pbr><metal><albedo_map>textures/wood.png</albedo_map></metal></pbr></material>
     </visual></link></model></sdf>)");
   }
-  void TearDown() override { fs::remove_all(dir_); }
 
   fs::path WriteWorld(const std::string& models) {
     const fs::path path = dir_ / "world.sdf";
@@ -48,7 +44,8 @@ class WorldModelTest : public ::testing::Test {
     return path;
   }
 
-  fs::path dir_;
+  ScratchFolder scratch_{"world_model_test"};
+  const fs::path& dir_ = scratch_.path();
 };
 
 TEST_F(WorldModelTest, ReadsPrimitivesWithComposedPoses) {

@@ -5,21 +5,16 @@
 #include <fstream>
 
 #include "arucoslam/util/error.h"
+#include "arucoslam/util/scratch_folder.h"
 
 namespace arucoslam {
 namespace {
 
 namespace fs = std::filesystem;
 
-fs::path FreshTempDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("arucoslam_files_test_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
 TEST(Files, AtomicWriteThenRead) {
-  const fs::path dir = FreshTempDir("atomic");
+  const ScratchFolder scratch("files_test");
+  const fs::path& dir = scratch.path();
   WriteTextFileAtomically(dir / "a.txt", "hello\n");
   EXPECT_EQ(ReadTextFile(dir / "a.txt"), "hello\n");
   int entries = 0;
@@ -38,7 +33,8 @@ TEST(Files, MissingFileNamesThePath) {
 }
 
 TEST(Files, StagedDirectoryIsRemovedWithoutCommit) {
-  const fs::path dir = FreshTempDir("staged");
+  const ScratchFolder scratch("files_test");
+  const fs::path& dir = scratch.path();
   const fs::path target = dir / "out";
   {
     StagedDirectory staged(target);
@@ -51,7 +47,8 @@ TEST(Files, StagedDirectoryIsRemovedWithoutCommit) {
 }
 
 TEST(Files, StagedDirectoryCommitReplacesTarget) {
-  const fs::path dir = FreshTempDir("commit");
+  const ScratchFolder scratch("files_test");
+  const fs::path& dir = scratch.path();
   const fs::path target = dir / "out";
   fs::create_directories(target);
   std::ofstream(target / "old.txt") << "old";

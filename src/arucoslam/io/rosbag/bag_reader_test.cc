@@ -2,7 +2,6 @@
 
 #include <gtest/gtest.h>
 #include <rosbag/bag.h>
-#include <unistd.h>
 
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -11,6 +10,7 @@
 #include "arucoslam/io/rosbag/camera_info.h"
 #include "arucoslam/io/rosbag/image_messages.h"
 #include "arucoslam/util/error.h"
+#include "arucoslam/util/scratch_folder.h"
 
 namespace arucoslam {
 namespace {
@@ -26,13 +26,7 @@ cv::Mat Pattern(int index) {
 
 class BagReaderTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("arucoslam_bag_reader_test_" + std::to_string(getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-    camera_ = PinholeCamera(32, 24, 30.0);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  void SetUp() override { camera_ = PinholeCamera(32, 24, 30.0); }
 
   // Three raw mono8 images at 0.1 s steps on /cam/image_raw, three PNG-compressed ones on
   // /cam/image_raw/compressed, camera_info on /cam/camera_info unless `with_info` is false.
@@ -58,7 +52,8 @@ class BagReaderTest : public ::testing::Test {
     return path;
   }
 
-  fs::path dir_;
+  ScratchFolder scratch_{"bag_reader_test"};
+  const fs::path& dir_ = scratch_.path();
   CameraModel camera_;
 };
 
