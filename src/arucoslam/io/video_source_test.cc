@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 #include <string>
+#include <system_error>
 
 #include "arucoslam/util/error.h"
 #include "arucoslam/util/files.h"
@@ -25,6 +26,17 @@ fs::path TestDir() {
   }();
   return dir;
 }
+
+// Removes TestDir() after the last test.
+class RemoveTestDir : public testing::Environment {
+ public:
+  void TearDown() override {
+    std::error_code ignored;
+    fs::remove_all(TestDir(), ignored);
+  }
+};
+const testing::Environment* const kRemoveTestDir =
+    testing::AddGlobalTestEnvironment(new RemoveTestDir);
 
 CameraModel SmallCamera() { return PinholeCamera(96, 64, 80.0); }
 
