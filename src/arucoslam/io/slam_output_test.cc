@@ -1,11 +1,11 @@
 #include "arucoslam/io/slam_output.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <sstream>
 
 #include "arucoslam/util/files.h"
+#include "arucoslam/util/scratch_folder.h"
 
 namespace arucoslam {
 namespace {
@@ -25,9 +25,8 @@ TEST(SlamOutput, PlyHasHeaderAndEveryPointAtFullPrecision) {
 }
 
 TEST(SlamOutput, WritesFourFilesThatReadBack) {
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("slam_output_test_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
+  const ScratchFolder scratch("slam_output_test");
+  const std::filesystem::path& dir = scratch.path();
   Trajectory trajectory;
   trajectory.Add(1.5, Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ())),
                              Eigen::Vector3d(1, 2, 3)));
@@ -73,7 +72,6 @@ TEST(SlamOutput, WritesFourFilesThatReadBack) {
   EXPECT_NE(json.find("\"interrupted\": false"), std::string::npos);
   EXPECT_NE(json.find("\"disambiguated_by_map_rotation\": 3"), std::string::npos);
   EXPECT_NE(ReadTextFile(dir / "map.ply").find("element vertex 1"), std::string::npos);
-  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
