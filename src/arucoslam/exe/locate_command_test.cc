@@ -71,9 +71,11 @@ class LocateCommandTest : public ::testing::Test {
   }
 
   std::string Args(const std::string& extra = "") const {
-    return "locate --image " + (folder_ / "image.png").string() + " --camera " +
-           (folder_ / "camera.yaml").string() + " --markers " +
-           (folder_ / "markers.json").string() + extra;
+    return ArgsWithImage(folder_ / "image.png") + extra;
+  }
+  std::string ArgsWithImage(const fs::path& image) const {
+    return "locate --image " + image.string() + " --camera " + (folder_ / "camera.yaml").string() +
+           " --markers " + (folder_ / "markers.json").string();
   }
 
   ScratchFolder scratch_{"locate_command_test"};
@@ -124,15 +126,8 @@ TEST_F(LocateCommandTest, NoKnownMarkerExitsOneWithAReason) {
 TEST_F(LocateCommandTest, BadInputIsOneLineAndStatusTwo) {
   WriteScene({3});
   for (const std::string& arguments :
-       {"locate --image " + (folder_ / "missing.png").string() + " --camera " +
-            (folder_ / "camera.yaml").string() + " --markers " +
-            (folder_ / "markers.json").string(),
-        "locate --image " + (folder_ / "camera.yaml").string() + " --camera " +
-            (folder_ / "camera.yaml").string() + " --markers " +
-            (folder_ / "markers.json").string(),
-        "locate --image " + folder_.string() + " --camera " + (folder_ / "camera.yaml").string() +
-            " --markers " + (folder_ / "markers.json").string(),
-        Args(" --refinement sharp")}) {
+       {ArgsWithImage(folder_ / "missing.png"), ArgsWithImage(folder_ / "camera.yaml"),
+        ArgsWithImage(folder_), Args(" --refinement sharp")}) {
     const RunResult result = Run(arguments);
     EXPECT_EQ(result.status, 2) << arguments;
     EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;

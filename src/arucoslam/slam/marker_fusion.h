@@ -145,7 +145,6 @@ class MarkerFusion {
   // The current fix's camera centre minus that of `cam_from_world` (needs fix_).
   Eigen::Vector3d MarkerOffset(const Rigid3& cam_from_world) const;
   bool Contradicts(const Rigid3& cam_from_world) const;
-  void VoteForWorldRotation(const Frame& frame);
 
   MarkerFusionOptions options_;
   CameraModel camera_;

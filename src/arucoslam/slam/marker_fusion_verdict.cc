@@ -27,11 +27,7 @@ PoseVerdict MarkerFusion::JudgeTrackedPose(const Frame& frame, bool world_aligne
 }
 
 void MarkerFusion::NoteTrackedFrame(const Frame& frame, bool world_aligned) {
-  if (!world_aligned) VoteForWorldRotation(frame);
-}
-
-void MarkerFusion::VoteForWorldRotation(const Frame& frame) {
-  if (!ambiguous_location_ || !frame.cam_from_world) return;
+  if (world_aligned || !ambiguous_location_ || !frame.cam_from_world) return;
   rotation_vote_.Add(*frame.cam_from_world, ambiguous_location_->world_from_cam,
                      *ambiguous_location_->alternative_world_from_cam);
   ambiguous_location_.reset();
