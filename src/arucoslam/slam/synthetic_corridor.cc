@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "arucoslam/slam/synthetic_descriptors.h"
 #include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
@@ -43,9 +44,7 @@ SyntheticCorridor::SyntheticCorridor(const CameraModel& camera,
     points_.push_back(p);
     blob_sizes_m_.push_back(options.min_blob_m +
                             unit(random_) * (options.max_blob_m - options.min_blob_m));
-    OrbDescriptor d;
-    for (auto& byte : d) byte = static_cast<std::uint8_t>(random_() & 0xff);
-    descriptors_.push_back(d);
+    descriptors_.push_back(RandomOrbDescriptor(random_));
   };
   const int per_wall = static_cast<int>(options.points_per_m2 * length * h);
   const int per_floor = static_cast<int>(options.points_per_m2 * length * 2.0 * w);
@@ -95,10 +94,7 @@ Frame SyntheticCorridor::MakeFrame(FrameId id, double timestamp_s, const Rigid3&
       cv::Mat(static_cast<int>(keypoints.size()), kOrbDescriptorBytes, CV_8U);
   for (std::size_t i = 0; i < keypoints.size(); ++i) {
     OrbDescriptor d = descriptors_[seen[i]];
-    for (int flip = 0; flip < 3; ++flip) {
-      const int bit = static_cast<int>(random_() % 256);
-      d[bit / 8] ^= static_cast<std::uint8_t>(1u << (bit % 8));
-    }
+    FlipRandomBits(3, random_, &d);
     std::copy(d.begin(), d.end(), frame.features.descriptors.ptr(static_cast<int>(i)));
     frame.features.undistorted.push_back(
         camera_.Unproject(Eigen::Vector2d(keypoints[i].pt.x, keypoints[i].pt.y)));

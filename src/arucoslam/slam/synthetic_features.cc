@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "arucoslam/slam/synthetic_descriptors.h"
 #include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
@@ -32,11 +33,7 @@ SyntheticFeatureScene::SyntheticFeatureScene(const CameraModel& camera,
   }
 }
 
-OrbDescriptor SyntheticFeatureScene::RandomDescriptor() {
-  OrbDescriptor d;
-  for (auto& byte : d) byte = static_cast<std::uint8_t>(random_() & 0xff);
-  return d;
-}
+OrbDescriptor SyntheticFeatureScene::RandomDescriptor() { return RandomOrbDescriptor(random_); }
 
 Frame SyntheticFeatureScene::MakeFrame(FrameId id, double timestamp_s,
                                        const Rigid3& cam_from_world, std::vector<int>* truth) {
@@ -55,10 +52,7 @@ Frame SyntheticFeatureScene::MakeFrame(FrameId id, double timestamp_s,
     const auto pixel = camera_.Project(p_in_cam);
     if (!pixel || !camera_.InImage(*pixel, options_.border_px)) continue;
     OrbDescriptor d = descriptors_[j];
-    for (int flip = 0; flip < options_.flipped_bits; ++flip) {
-      const int bit = static_cast<int>(random_() % 256);
-      d[bit / 8] ^= static_cast<std::uint8_t>(1u << (bit % 8));
-    }
+    FlipRandomBits(options_.flipped_bits, random_, &d);
     entries.push_back({*pixel + Eigen::Vector2d(noise(random_), noise(random_)), d,
                        static_cast<int>(j)});
   }

@@ -5,6 +5,8 @@
 #include <map>
 #include <random>
 
+#include "arucoslam/slam/synthetic_descriptors.h"
+
 namespace arucoslam {
 namespace {
 
@@ -27,9 +29,7 @@ Wall MakeWall(int count, std::mt19937& random) {
     const double radius = 15.0 + 2.0 * unit(random);
     wall.points.emplace_back(radius * std::cos(angle), 4.0 * unit(random) - 2.0,
                              radius * std::sin(angle));
-    Descriptor descriptor;
-    for (auto& byte : descriptor) byte = static_cast<std::uint8_t>(random() & 0xff);
-    wall.descriptors.push_back(descriptor);
+    wall.descriptors.push_back(RandomOrbDescriptor(random));
   }
   return wall;
 }

@@ -7,6 +7,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "arucoslam/slam/synthetic_descriptors.h"
 #include "arucoslam/util/option_check.h"
 
 namespace arucoslam {
@@ -57,11 +58,7 @@ Rigid3 SyntheticRoute::CamFromWorld(double azimuth_deg, double yaw_deg, double r
   return Rigid3(world_from_cam_rotation, centre).Inverse();
 }
 
-OrbDescriptor SyntheticRoute::RandomDescriptor() {
-  OrbDescriptor d;
-  for (auto& byte : d) byte = static_cast<std::uint8_t>(random_() & 0xff);
-  return d;
-}
+OrbDescriptor SyntheticRoute::RandomDescriptor() { return RandomOrbDescriptor(random_); }
 
 std::vector<MarkerObservation> SyntheticRoute::VisibleMarkers(const Rigid3& cam_from_world) const {
   const CameraModel camera = Camera();
@@ -121,10 +118,7 @@ Frame SyntheticRoute::MakeFrame(FrameId id, const Rigid3& cam_from_world, int nu
     OrbDescriptor d = point >= 0 ? descriptors_[point] : RandomDescriptor();
     const int flips =
         point >= 0 ? static_cast<int>(random_() % (options_.max_flipped_bits + 1)) : 0;
-    for (int flip = 0; flip < flips; ++flip) {
-      const int bit = static_cast<int>(random_() % 256);
-      d[bit / 8] ^= static_cast<std::uint8_t>(1u << (bit % 8));
-    }
+    FlipRandomBits(flips, random_, &d);
     std::copy(d.begin(), d.end(), frame.features.descriptors.ptr(static_cast<int>(i)));
     truth->push_back(point);
   }
